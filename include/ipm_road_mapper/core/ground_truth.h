@@ -23,6 +23,7 @@ struct GroundTruthMarking {
   std::string class_name;
   std::array<Eigen::Vector3d, 4> corners_map;
   Eigen::Vector3d center_map = Eigen::Vector3d::Zero();
+  int visible_frames = 0;  // frames whose mask holds it (recall counts only seen markings)
 };
 
 // A true lane line as a dense polyline (a point every 0.1 m along the line's center).
