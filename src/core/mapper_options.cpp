@@ -31,20 +31,64 @@ IpmOptions LoadIpmOptions(OptionsReader reader) {
   return o;
 }
 
-MapperOptions LoadMapperOptions(OptionsReader reader) {
-  MapperOptions o;
-  o.ipm = LoadIpmOptions(reader.Child("ipm"));
+LaneOptions LoadLaneOptions(OptionsReader reader) {
+  LaneOptions o;
+  reader.Read<bool>("point_selection", &o.point_selection);
+  reader.Read<int>("selected_points_per_frame", &o.selected_points_per_frame, CheckPositiveInt);
+  reader.Read<double>("max_selected_score_m2", &o.max_selected_score_m2, CheckPositive);
+  reader.Read<double>("chord_spacing_m", &o.fit.chord_spacing_m, CheckPositive);
+  reader.Read<double>("smoothing_length_m", &o.fit.smoothing_length_m, CheckPositive);
+  reader.Read<int>("refit_every_n_frames", &o.refit_every_n_frames, CheckPositiveInt);
+  reader.Read<double>("min_new_lane_length_m", &o.min_new_lane_length_m, CheckNonNegative);
   reader.RejectUnknownKeys();
   return o;
 }
 
+OdometryOptions LoadOdometryOptions(OptionsReader reader) {
+  OdometryOptions o;
+  reader.Read<double>("stamp_tolerance_s", &o.stamp_tolerance_s, CheckNonNegative);
+  reader.Read<double>("max_gap_s", &o.max_gap_s, CheckPositive);
+  reader.Read<int>("buffer_size", &o.buffer_size, CheckPositiveInt);
+  reader.RejectUnknownKeys();
+  return o;
+}
+
+MapperOptions LoadMapperOptions(OptionsReader reader) {
+  MapperOptions o;
+  reader.Read<std::string>("method", &o.method);
+  o.ipm = LoadIpmOptions(reader.Child("ipm"));
+  o.extraction = LoadExtractionOptions(reader.Child("extraction"));
+  o.association = LoadAssociationOptions(reader.Child("association"));
+  o.lanes = LoadLaneOptions(reader.Child("lanes"));
+  o.odometry = LoadOdometryOptions(reader.Child("odometry"));
+  o.input = LoadInputOptions(reader.Child("input"));
+  reader.RejectUnknownKeys();
+  return o;
+}
+
+MapperOptions LoadMapperOptionsFile(const std::string& path) {
+  try {
+    return LoadMapperOptions(OptionsReader::FromFile(path));
+  } catch (const OptionsError& e) {
+    const std::string what = e.what();
+    // FromFile already names the file; prefix it for errors found in the content.
+    throw OptionsError(what.rfind(path, 0) == 0 ? what : path + ": " + what);
+  }
+}
+
 std::string ToString(const MapperOptions& o) {
   std::ostringstream s;
-  s << "ipm.max_range_m: " << o.ipm.max_range_m << "\n"
+  s << "method: " << o.method << "\n"
+    << "ipm.max_range_m: " << o.ipm.max_range_m << "\n"
     << "ipm.pixel_error_px: [" << o.ipm.error_model.pixel_error_px.x() << ", "
     << o.ipm.error_model.pixel_error_px.y() << "]\n"
     << "ipm.pitch_sigma_deg: " << o.ipm.error_model.pitch_sigma_rad / kDegToRad << "\n"
-    << "ipm.height_sigma_m: " << o.ipm.error_model.height_sigma_m << "\n";
+    << "ipm.height_sigma_m: " << o.ipm.error_model.height_sigma_m << "\n"
+    << "lanes.point_selection: " << (o.lanes.point_selection ? "true" : "false") << "\n"
+    << "lanes.selected_points_per_frame: " << o.lanes.selected_points_per_frame << "\n"
+    << "lanes.chord_spacing_m: " << o.lanes.fit.chord_spacing_m << "\n"
+    << "association.marking_gate_m: " << o.association.marking_gate_m << "\n"
+    << "association.lane_gate_m: " << o.association.lane_gate_m << "\n";
   return s.str();
 }
 

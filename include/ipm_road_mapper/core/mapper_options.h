@@ -6,7 +6,11 @@
 
 #include <string>
 
+#include "ipm_road_mapper/core/association.h"
+#include "ipm_road_mapper/core/input_options.h"
+#include "ipm_road_mapper/core/instance_extraction.h"
 #include "ipm_road_mapper/core/ipm_uncertainty.h"
+#include "ipm_road_mapper/core/spline_fitting.h"
 #include "ipm_road_mapper/core/yaml_options.h"
 
 namespace ipm_road_mapper {
@@ -17,16 +21,48 @@ struct IpmOptions {
   IpmErrorModel error_model;  // Omega_p inputs (DESIGN.md defaults)
 };
 
+// How lane lines become splines (config section `lanes`).
+struct LaneOptions {
+  bool point_selection = true;        // PS: keep only the lowest-uncertainty points per frame
+  int selected_points_per_frame = 12; // N of PS, per lane observation
+  double max_selected_score_m2 = 1.0; // PS also drops points with tr(Omega_p) above this
+  SplineFitOptions fit;               // g: chord spacing etc.
+  int refit_every_n_frames = 20;      // full re-estimation of a lane's control points
+  double min_new_lane_length_m = 3.0; // an unmatched observation shorter than this: no lane
+};
+
+// Odometry buffering at the mask stamp (config section `odometry`).
+struct OdometryOptions {
+  double stamp_tolerance_s = 0.05;  // a mask this far outside the odometry span is still ok
+  double max_gap_s = 0.5;           // bracketing odometry farther apart: frame skipped
+  int buffer_size = 2000;           // odometry messages kept for interpolation
+};
+
 // Everything the mapper is configured with.
 struct MapperOptions {
+  std::string method = "ipm";  // name of the configuration, e.g. ipm, ours_ppsr
   IpmOptions ipm;
+  ExtractionOptions extraction;
+  AssociationOptions association;
+  LaneOptions lanes;
+  OdometryOptions odometry;
+  InputOptions input;
 };
 
 // Reads the `ipm` section; throws OptionsError naming the bad key.
 IpmOptions LoadIpmOptions(OptionsReader reader);
 
+// Reads the `lanes` section; throws OptionsError naming the bad key.
+LaneOptions LoadLaneOptions(OptionsReader reader);
+
+// Reads the `odometry` section; throws OptionsError naming the bad key.
+OdometryOptions LoadOdometryOptions(OptionsReader reader);
+
 // Reads a whole mapper config; unknown keys are errors. Throws OptionsError.
 MapperOptions LoadMapperOptions(OptionsReader reader);
+
+// Loads a mapper config file; errors are prefixed with the file path.
+MapperOptions LoadMapperOptionsFile(const std::string& path);
 
 // A multi-line, human-readable dump of the options (printed at start-up).
 std::string ToString(const MapperOptions& options);

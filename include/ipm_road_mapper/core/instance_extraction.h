@@ -1,0 +1,43 @@
+// Instance extraction: 16UC1 instance mask -> marking rectangles and lane centerline points
+// on the ground of base_link (DESIGN.md §2 encoding, §4 markings).
+#pragma once
+
+#include <opencv2/core.hpp>
+#include <string>
+
+#include "ipm_road_mapper/core/class_table.h"
+#include "ipm_road_mapper/core/ipm.h"
+#include "ipm_road_mapper/core/ipm_uncertainty.h"
+#include "ipm_road_mapper/core/observations.h"
+#include "ipm_road_mapper/core/yaml_options.h"
+
+namespace ipm_road_mapper {
+
+// Tuning of the extraction (config section `extraction`).
+struct ExtractionOptions {
+  int min_marking_pixels = 150;       // smaller marking instances are dropped (tiny)
+  int min_lane_pixels = 80;           // smaller lane instances are dropped (tiny)
+  int border_margin_px = 2;           // markings with a pixel this close to the border: truncated
+  int lane_row_step = 4;              // take a lane centerline point every this many rows
+  int min_lane_points = 4;            // fewer valid centerline points: degenerate
+  int max_instances_per_frame = 300;  // beyond this, the remaining instances are dropped
+  double max_marking_range_m = 25.0;  // marking whose ground center is farther: dropped
+  double min_rectangle_side_m = 0.05; // thinner ground rectangles are degenerate
+};
+
+// Reads the `extraction` section; throws OptionsError naming the bad key.
+ExtractionOptions LoadExtractionOptions(OptionsReader reader);
+
+// Checks a mask before extraction: CV_16UC1 and the camera's size. Empty when usable,
+// otherwise the reason (e.g. "mask is 640x480, camera is 1280x720").
+std::string ValidateMask(const cv::Mat& mask, int expected_width, int expected_height);
+
+// Extracts every instance of `mask` (which must pass ValidateMask). Markings: outer contour
+// -> IPM of the contour pixels -> minimum-area rectangle on the ground -> canonical corners,
+// projected back for the pixel measurements. Lanes: centerline pixel per sampled row (mean
+// column of the instance's pixels in that row) -> IPM point + uncertainty score.
+FrameObservations ExtractObservations(const cv::Mat& mask, const ClassTable& classes,
+                                      const Ipm& ipm, const IpmErrorModel& error_model,
+                                      const ExtractionOptions& options);
+
+}  // namespace ipm_road_mapper

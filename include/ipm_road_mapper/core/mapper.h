@@ -1,0 +1,94 @@
+// The core mapper: takes one FrameInput at a time (mask + camera + odometry pose at the
+// mask stamp) and keeps the vectorized map. No ROS: the nodelet and the offline runner
+// both drive it. Bad input is skipped and counted, never fatal, and never touches the map.
+#pragma once
+
+#include <Eigen/Geometry>
+#include <cstdint>
+#include <map>
+#include <opencv2/core.hpp>
+#include <string>
+
+#include "ipm_road_mapper/core/class_table.h"
+#include "ipm_road_mapper/core/mapper_options.h"
+#include "ipm_road_mapper/core/pinhole_camera.h"
+#include "ipm_road_mapper/core/road_map.h"
+#include "ipm_road_mapper/core/vector_map.h"
+
+namespace ipm_road_mapper {
+
+// One camera frame as the core sees it (DESIGN.md §3).
+struct FrameInput {
+  double stamp = 0.0;                 // s, the mask's stamp
+  cv::Mat mask;                       // CV_16UC1 instance mask, camera-sized
+  CameraIntrinsics camera;            // from camera_info
+  Eigen::Isometry3d T_map_base_odom = Eigen::Isometry3d::Identity();  // odometry at stamp
+};
+
+// What happened to a frame.
+enum class FrameStatus { kUsed, kSkipped };
+
+// Counters of everything the mapper did or refused, by reason (printed in summaries,
+// published as diagnostics).
+struct MapperCounters {
+  std::uint64_t frames_received = 0;
+  std::uint64_t frames_used = 0;
+  std::map<std::string, std::uint64_t> frames_skipped;  // reason -> count
+  ExtractionCounters extraction;
+  std::uint64_t markings_created = 0;
+  std::uint64_t lanes_created = 0;
+  std::uint64_t spurious_dropped = 0;
+  std::uint64_t lanes_merged = 0;
+  std::uint64_t lane_observations_unused = 0;  // unmatched and too short / unfit to start a lane
+  std::uint64_t SkippedTotal() const;
+};
+
+// Front end of the mapper (the plain-IPM map; the back end refines it).
+class Mapper {
+ public:
+  Mapper(MapperOptions options, ClassTable classes, const Eigen::Isometry3d& T_base_cam_initial);
+
+  // Processes one frame. On kSkipped, *reason (if given) says why, e.g. "bad_mask: mask is
+  // 640x480, camera is 1280x720"; the counter of that reason is incremented.
+  FrameStatus ProcessFrame(const FrameInput& input, std::string* reason = nullptr);
+
+  // Counts a frame the caller could not even build (e.g. no odometry at its stamp).
+  void CountSkipped(const std::string& reason);
+
+  // The map as exported (map.json): lanes re-estimated from all their selected points.
+  VectorMap ExportMap() const;
+
+  // Drops the whole map and the frames, keeps options and extrinsic.
+  void Reset();
+
+  // Feeds a refined extrinsic forward (from the back end); used for the next frames' IPM.
+  void SetExtrinsic(const Eigen::Isometry3d& T_base_cam) { T_base_cam_ = T_base_cam; }
+
+  const RoadMap& map() const { return map_; }
+  const MapperCounters& counters() const { return counters_; }
+  const MapperOptions& options() const { return options_; }
+  const ClassTable& classes() const { return classes_; }
+  const Eigen::Isometry3d& T_base_cam() const { return T_base_cam_; }
+  const Eigen::Isometry3d& T_base_cam_initial() const { return T_base_cam_initial_; }
+
+ private:
+  std::string ValidateInput(const FrameInput& input) const;
+  void AddMarkings(const FrameObservations& observations, const FrameRecord& frame);
+  void AddLanes(const FrameObservations& observations, const FrameRecord& frame);
+  void StartLane(int class_id, const LaneMeasurement& measurement,
+                 const std::vector<Eigen::Vector3d>& selected_map, const FrameRecord& frame);
+  void RefitLane(LaneElement* lane) const;
+  void MergeLanes();
+  void DropSpurious(std::size_t frame_index);
+  void Skip(const std::string& reason, std::string* out);
+
+  MapperOptions options_;
+  ClassTable classes_;
+  Eigen::Isometry3d T_base_cam_initial_;
+  Eigen::Isometry3d T_base_cam_;
+  RoadMap map_;
+  MapperCounters counters_;
+  double last_stamp_ = -1.0;
+};
+
+}  // namespace ipm_road_mapper

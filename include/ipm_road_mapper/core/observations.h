@@ -1,0 +1,60 @@
+// What the front end extracts from one instance mask: per marking instance the 4 corners
+// of its bounding rectangle (pixels and ground), per lane instance its centerline points
+// (pixels, ground, IPM uncertainty score). Ground points are in base_link (z = 0).
+#pragma once
+
+#include <Eigen/Core>
+#include <array>
+#include <cstdint>
+#include <string>
+#include <vector>
+
+namespace ipm_road_mapper {
+
+// One marking instance of one frame.
+struct MarkingObservation {
+  int class_id = 0;
+  int instance_value = 0;  // the mask pixel value, class_id * 1000 + instance_index
+  // Corners of the minimum-area rectangle on the ground, canonical order: starting at the
+  // corner nearest base_link's origin, counter-clockwise seen from above.
+  std::array<Eigen::Vector3d, 4> corners_base;
+  // The same corners projected back into the image: the pixel measurements z_k.
+  std::array<Eigen::Vector2d, 4> corners_uv;
+  int pixel_count = 0;
+};
+
+// One centerline point of a lane instance.
+struct LanePoint {
+  Eigen::Vector2d uv = Eigen::Vector2d::Zero();       // pixel (the PPSR measurement)
+  Eigen::Vector3d p_base = Eigen::Vector3d::Zero();   // its IPM ground point
+  double score = 0.0;                                 // tr(Omega_p), m^2
+};
+
+// One lane instance of one frame (all dashes of one line share an instance).
+struct LaneObservation {
+  int class_id = 0;
+  int instance_value = 0;
+  std::vector<LanePoint> points;  // ordered by image row, bottom (near) first
+  int pixel_count = 0;
+};
+
+// Why an instance (or a whole mask) was not used; counted, never silent.
+struct ExtractionCounters {
+  std::uint64_t instances_seen = 0;
+  std::uint64_t dropped_unknown_class = 0;   // class id not in the class table
+  std::uint64_t dropped_tiny = 0;            // fewer pixels than the class kind's minimum
+  std::uint64_t dropped_border = 0;          // marking touching the image border (truncated)
+  std::uint64_t dropped_range = 0;           // beyond max range or above the horizon
+  std::uint64_t dropped_degenerate = 0;      // too few valid lane points / flat rectangle
+  std::uint64_t dropped_instance_limit = 0;  // more instances than max_instances_per_frame
+  void Add(const ExtractionCounters& o);
+};
+
+// Everything extracted from one mask.
+struct FrameObservations {
+  std::vector<MarkingObservation> markings;
+  std::vector<LaneObservation> lanes;
+  ExtractionCounters counters;
+};
+
+}  // namespace ipm_road_mapper

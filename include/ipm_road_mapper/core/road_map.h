@@ -1,0 +1,72 @@
+// The mapper's working map: elements with their observation histories (what the back end
+// optimizes over) and the frames that observed them. VectorMap (vector_map.h) is the
+// exported view of it.
+#pragma once
+
+#include <Eigen/Geometry>
+#include <array>
+#include <cstddef>
+#include <cstdint>
+#include <vector>
+
+#include "ipm_road_mapper/core/observations.h"
+
+namespace ipm_road_mapper {
+
+// One frame the mapper used: its odometry pose and its current (corrected) pose.
+struct FrameRecord {
+  std::size_t index = 0;  // position in RoadMap::frames
+  double stamp = 0.0;
+  Eigen::Isometry3d T_map_base_odom = Eigen::Isometry3d::Identity();
+  Eigen::Isometry3d T_map_base = Eigen::Isometry3d::Identity();  // corrected estimate
+};
+
+// One observation of a marking, corners already in the element's corner order.
+struct MarkingMeasurement {
+  std::size_t frame_index = 0;
+  std::array<Eigen::Vector2d, 4> corners_uv;    // pixel measurements z_k
+  std::array<Eigen::Vector3d, 4> corners_base;  // their IPM ground points at observation time
+};
+
+// A mapped ground marking.
+struct MarkingElement {
+  std::uint64_t id = 0;
+  int class_id = 0;
+  std::array<Eigen::Vector3d, 4> corners_map;  // current estimate
+  std::vector<MarkingMeasurement> history;
+  std::size_t first_frame = 0, last_frame = 0;
+  double first_seen = 0.0, last_seen = 0.0;
+  Eigen::Vector3d Center() const {
+    return 0.25 * (corners_map[0] + corners_map[1] + corners_map[2] + corners_map[3]);
+  }
+};
+
+// One observation of a lane: its centerline points (pixels, ground, scores) and which of
+// them point selection kept.
+struct LaneMeasurement {
+  std::size_t frame_index = 0;
+  std::vector<LanePoint> points;
+  std::vector<std::uint8_t> selected;  // 1 where PS kept the point (all 1 without PS)
+};
+
+// A mapped lane line.
+struct LaneElement {
+  std::uint64_t id = 0;
+  int class_id = 0;
+  std::vector<Eigen::Vector3d> control_points_map;  // Catmull-Rom, phantom ends included
+  std::vector<Eigen::Vector3d> fit_points_map;      // selected points, input of g
+  std::vector<LaneMeasurement> history;
+  std::size_t first_frame = 0, last_frame = 0;
+  double first_seen = 0.0, last_seen = 0.0;
+  std::size_t fit_points_at_last_refit = 0;
+};
+
+// Elements and frames.
+struct RoadMap {
+  std::vector<FrameRecord> frames;
+  std::vector<MarkingElement> markings;
+  std::vector<LaneElement> lanes;
+  std::uint64_t next_id = 1;
+};
+
+}  // namespace ipm_road_mapper

@@ -1,0 +1,137 @@
+#include "ipm_road_mapper/core/association.h"
+
+#include <algorithm>
+#include <cmath>
+#include <limits>
+#include <tuple>
+
+#include "ipm_road_mapper/core/catmull_rom_spline.h"
+
+namespace ipm_road_mapper {
+
+AssociationOptions LoadAssociationOptions(OptionsReader reader) {
+  AssociationOptions o;
+  reader.Read<double>("marking_gate_m", &o.marking_gate_m, CheckPositive);
+  reader.Read<double>("lane_gate_m", &o.lane_gate_m, CheckPositive);
+  reader.Read<double>("lane_min_direction_cos", &o.lane_min_direction_cos, CheckProbability);
+  reader.Read<double>("lane_max_end_gap_m", &o.lane_max_end_gap_m, CheckNonNegative);
+  reader.Read<double>("lane_min_support", &o.lane_min_support, CheckProbability);
+  reader.Read<int>("spurious_after_frames", &o.spurious_after_frames, CheckPositiveInt);
+  reader.RejectUnknownKeys();
+  return o;
+}
+
+int BestCyclicShift(const std::array<Eigen::Vector3d, 4>& element,
+                    const std::array<Eigen::Vector3d, 4>& observation, double* mean_distance_m) {
+  int best_shift = 0;
+  double best_sum = std::numeric_limits<double>::infinity();
+  for (int shift = 0; shift < 4; ++shift) {
+    double sum = 0.0;
+    for (int i = 0; i < 4; ++i) sum += (element[i] - observation[(i + shift) % 4]).norm();
+    if (sum < best_sum) {
+      best_sum = sum;
+      best_shift = shift;
+    }
+  }
+  if (mean_distance_m) *mean_distance_m = best_sum / 4.0;
+  return best_shift;
+}
+
+namespace {
+
+// Greedy one-to-one assignment over (cost, candidate, element) triples.
+std::vector<int> AssignGreedy(std::vector<std::tuple<double, int, int>> pairs, int num_candidates,
+                              int num_elements) {
+  std::sort(pairs.begin(), pairs.end());
+  std::vector<int> assignment(num_candidates, -1);
+  std::vector<bool> element_taken(num_elements, false);
+  for (const auto& [cost, candidate, element] : pairs) {
+    if (assignment[candidate] >= 0 || element_taken[element]) continue;
+    assignment[candidate] = element;
+    element_taken[element] = true;
+  }
+  return assignment;
+}
+
+Eigen::Vector3d Mean(const std::array<Eigen::Vector3d, 4>& corners) {
+  return 0.25 * (corners[0] + corners[1] + corners[2] + corners[3]);
+}
+
+}  // namespace
+
+std::vector<int> AssociateMarkings(const std::vector<MarkingElement>& elements,
+                                   const std::vector<MarkingCandidate>& candidates,
+                                   const AssociationOptions& options) {
+  std::vector<std::tuple<double, int, int>> pairs;
+  for (int c = 0; c < static_cast<int>(candidates.size()); ++c) {
+    const Eigen::Vector3d center = Mean(candidates[c].corners_map);
+    for (int e = 0; e < static_cast<int>(elements.size()); ++e) {
+      if (elements[e].class_id != candidates[c].class_id) continue;
+      // Compare in x-y: the mapped z of a marking is refined later, the gate is planar.
+      const double distance = (elements[e].Center() - center).head<2>().norm();
+      if (distance <= options.marking_gate_m) pairs.emplace_back(distance, c, e);
+    }
+  }
+  return AssignGreedy(std::move(pairs), static_cast<int>(candidates.size()),
+                      static_cast<int>(elements.size()));
+}
+
+double LaneAssociationCost(const LaneElement& lane, const LaneCandidate& candidate,
+                           const AssociationOptions& options) {
+  if (lane.class_id != candidate.class_id || lane.control_points_map.size() < 4 ||
+      candidate.points_map.size() < 2) {
+    return -1.0;
+  }
+  const CatmullRomSpline spline(lane.control_points_map);
+  // Observation direction: from its first to its last point (ordered along the lane).
+  Eigen::Vector2d obs_dir = (candidate.points_map.back() - candidate.points_map.front()).head<2>();
+  if (obs_dir.norm() < 1e-6) return -1.0;
+  obs_dir.normalize();
+
+  // Use at most ~12 points spread over the observation: association runs every frame.
+  const std::size_t n = candidate.points_map.size();
+  const std::size_t step = std::max<std::size_t>(1, n / 12);
+  std::vector<double> lateral;
+  int used = 0, direction_votes = 0, direction_ok = 0;
+  const double end_s = spline.NumSegments();
+  for (std::size_t i = 0; i < n; i += step, ++used) {
+    const Eigen::Vector3d& p = candidate.points_map[i];
+    const CatmullRomSpline::ClosestPoint closest = spline.FindClosest(p);
+    Eigen::Vector2d tangent = spline.Derivative(closest.s).head<2>();
+    if (tangent.norm() < 1e-9) continue;
+    tangent.normalize();
+    const Eigen::Vector2d offset = (p - closest.point).head<2>();
+    const double along = offset.dot(tangent);
+    const bool at_end = closest.s <= 1e-6 || closest.s >= end_s - 1e-6;
+    if (at_end && std::abs(along) > options.lane_max_end_gap_m) continue;
+    // Past an end, the lateral distance is measured to the end tangent line.
+    const double lateral_m = at_end ? std::abs(offset.x() * tangent.y() - offset.y() * tangent.x())
+                                    : offset.norm();
+    lateral.push_back(lateral_m);
+    ++direction_votes;
+    if (std::abs(tangent.dot(obs_dir)) >= options.lane_min_direction_cos) ++direction_ok;
+  }
+  if (used == 0 || lateral.size() < std::max<std::size_t>(2, options.lane_min_support * used)) {
+    return -1.0;
+  }
+  if (direction_ok * 2 < direction_votes) return -1.0;
+  std::nth_element(lateral.begin(), lateral.begin() + lateral.size() / 2, lateral.end());
+  const double median = lateral[lateral.size() / 2];
+  return median <= options.lane_gate_m ? median : -1.0;
+}
+
+std::vector<int> AssociateLanes(const std::vector<LaneElement>& lanes,
+                                const std::vector<LaneCandidate>& candidates,
+                                const AssociationOptions& options) {
+  std::vector<std::tuple<double, int, int>> pairs;
+  for (int c = 0; c < static_cast<int>(candidates.size()); ++c) {
+    for (int e = 0; e < static_cast<int>(lanes.size()); ++e) {
+      const double cost = LaneAssociationCost(lanes[e], candidates[c], options);
+      if (cost >= 0.0) pairs.emplace_back(cost, c, e);
+    }
+  }
+  return AssignGreedy(std::move(pairs), static_cast<int>(candidates.size()),
+                      static_cast<int>(lanes.size()));
+}
+
+}  // namespace ipm_road_mapper

@@ -1,0 +1,328 @@
+#include "ipm_road_mapper/core/mapper.h"
+
+#include <algorithm>
+#include <cmath>
+#include <sstream>
+
+#include "ipm_road_mapper/core/association.h"
+#include "ipm_road_mapper/core/instance_extraction.h"
+#include "ipm_road_mapper/core/ipm.h"
+#include "ipm_road_mapper/core/spline_fitting.h"
+
+namespace ipm_road_mapper {
+
+std::uint64_t MapperCounters::SkippedTotal() const {
+  std::uint64_t total = 0;
+  for (const auto& [reason, count] : frames_skipped) total += count;
+  return total;
+}
+
+Mapper::Mapper(MapperOptions options, ClassTable classes,
+               const Eigen::Isometry3d& T_base_cam_initial)
+    : options_(std::move(options)),
+      classes_(std::move(classes)),
+      T_base_cam_initial_(T_base_cam_initial),
+      T_base_cam_(T_base_cam_initial) {}
+
+void Mapper::Skip(const std::string& reason, std::string* out) {
+  const std::string key = reason.substr(0, reason.find(':'));
+  ++counters_.frames_skipped[key];
+  if (out) *out = reason;
+}
+
+void Mapper::CountSkipped(const std::string& reason) {
+  ++counters_.frames_received;
+  Skip(reason, nullptr);
+}
+
+std::string Mapper::ValidateInput(const FrameInput& input) const {
+  if (!std::isfinite(input.stamp)) return "bad_stamp: stamp is not finite";
+  if (input.stamp <= last_stamp_) {
+    std::ostringstream s;
+    s << "time_jump: stamp " << input.stamp << " s is not after the last frame's "
+      << last_stamp_ << " s";
+    return s.str();
+  }
+  const std::string camera_error = PinholeCamera(input.camera).Validate();
+  if (!camera_error.empty()) return "bad_camera: " + camera_error;
+  const std::string mask_error =
+      ValidateMask(input.mask, input.camera.width, input.camera.height);
+  if (!mask_error.empty()) return "bad_mask: " + mask_error;
+  if (!IsValidTransform(input.T_map_base_odom)) {
+    return "bad_pose: odometry pose is not finite or not a rotation";
+  }
+  return "";
+}
+
+FrameStatus Mapper::ProcessFrame(const FrameInput& input, std::string* reason) {
+  ++counters_.frames_received;
+  const std::string error = ValidateInput(input);
+  if (!error.empty()) {
+    Skip(error, reason);
+    return FrameStatus::kSkipped;
+  }
+  last_stamp_ = input.stamp;
+
+  const Ipm ipm(PinholeCamera(input.camera), T_base_cam_, options_.ipm.max_range_m);
+  FrameObservations observations = ExtractObservations(
+      input.mask, classes_, ipm, options_.ipm.error_model, options_.extraction);
+  counters_.extraction.Add(observations.counters);
+
+  FrameRecord frame;
+  frame.index = map_.frames.size();
+  frame.stamp = input.stamp;
+  frame.T_map_base_odom = input.T_map_base_odom;
+  frame.T_map_base = input.T_map_base_odom;
+  map_.frames.push_back(frame);
+
+  AddMarkings(observations, frame);
+  AddLanes(observations, frame);
+  DropSpurious(frame.index);
+  ++counters_.frames_used;
+  return FrameStatus::kUsed;
+}
+
+void Mapper::AddMarkings(const FrameObservations& observations, const FrameRecord& frame) {
+  std::vector<MarkingCandidate> candidates;
+  candidates.reserve(observations.markings.size());
+  for (const MarkingObservation& obs : observations.markings) {
+    MarkingCandidate candidate;
+    candidate.class_id = obs.class_id;
+    for (int i = 0; i < 4; ++i) candidate.corners_map[i] = frame.T_map_base * obs.corners_base[i];
+    candidates.push_back(candidate);
+  }
+  const std::vector<int> match =
+      AssociateMarkings(map_.markings, candidates, options_.association);
+  for (std::size_t c = 0; c < candidates.size(); ++c) {
+    const MarkingObservation& obs = observations.markings[c];
+    if (match[c] < 0) {
+      MarkingElement element;
+      element.id = map_.next_id++;
+      element.class_id = obs.class_id;
+      element.corners_map = candidates[c].corners_map;
+      element.history.push_back({frame.index, obs.corners_uv, obs.corners_base});
+      element.first_frame = element.last_frame = frame.index;
+      element.first_seen = element.last_seen = frame.stamp;
+      map_.markings.push_back(std::move(element));
+      ++counters_.markings_created;
+      continue;
+    }
+    MarkingElement& element = map_.markings[match[c]];
+    const int shift = BestCyclicShift(element.corners_map, candidates[c].corners_map, nullptr);
+    MarkingMeasurement measurement;
+    measurement.frame_index = frame.index;
+    for (int i = 0; i < 4; ++i) {
+      measurement.corners_uv[i] = obs.corners_uv[(i + shift) % 4];
+      measurement.corners_base[i] = obs.corners_base[(i + shift) % 4];
+    }
+    element.history.push_back(measurement);
+    // Plain IPM estimate: the running mean of the observed corners in the map.
+    const double n = static_cast<double>(element.history.size());
+    for (int i = 0; i < 4; ++i) {
+      element.corners_map[i] += (candidates[c].corners_map[(i + shift) % 4] -
+                                 element.corners_map[i]) / n;
+    }
+    element.last_frame = frame.index;
+    element.last_seen = frame.stamp;
+  }
+}
+
+namespace {
+
+// Point selection (PS): flags of the points kept for control-point estimation.
+std::vector<std::uint8_t> SelectPoints(const std::vector<LanePoint>& points,
+                                       const LaneOptions& options) {
+  std::vector<std::uint8_t> selected(points.size(), options.point_selection ? 0 : 1);
+  if (!options.point_selection) return selected;
+  std::vector<double> scores;
+  scores.reserve(points.size());
+  for (const LanePoint& p : points) {
+    scores.push_back(p.score <= options.max_selected_score_m2 ? p.score
+                                                               : std::nan(""));
+  }
+  for (std::size_t i : SelectLowestScores(scores, options.selected_points_per_frame)) {
+    selected[i] = 1;
+  }
+  return selected;
+}
+
+double Extent(const std::vector<Eigen::Vector3d>& points) {
+  double extent = 0.0;
+  for (std::size_t i = 1; i < points.size(); ++i) {
+    extent = std::max(extent, (points[i] - points.front()).head<2>().norm());
+  }
+  return extent;
+}
+
+}  // namespace
+
+void Mapper::AddLanes(const FrameObservations& observations, const FrameRecord& frame) {
+  std::vector<LaneCandidate> candidates;
+  std::vector<LaneMeasurement> measurements;
+  for (const LaneObservation& obs : observations.lanes) {
+    LaneCandidate candidate;
+    candidate.class_id = obs.class_id;
+    for (const LanePoint& p : obs.points) candidate.points_map.push_back(frame.T_map_base * p.p_base);
+    LaneMeasurement measurement;
+    measurement.frame_index = frame.index;
+    measurement.points = obs.points;
+    measurement.selected = SelectPoints(obs.points, options_.lanes);
+    candidates.push_back(std::move(candidate));
+    measurements.push_back(std::move(measurement));
+  }
+  const std::vector<int> match = AssociateLanes(map_.lanes, candidates, options_.association);
+  for (std::size_t c = 0; c < candidates.size(); ++c) {
+    std::vector<Eigen::Vector3d> selected_map;
+    for (std::size_t i = 0; i < candidates[c].points_map.size(); ++i) {
+      if (measurements[c].selected[i]) selected_map.push_back(candidates[c].points_map[i]);
+    }
+    if (match[c] < 0) {
+      StartLane(candidates[c].class_id, measurements[c], selected_map, frame);
+      continue;
+    }
+    LaneElement& lane = map_.lanes[match[c]];
+    lane.history.push_back(std::move(measurements[c]));
+    lane.fit_points_map.insert(lane.fit_points_map.end(), selected_map.begin(),
+                               selected_map.end());
+    lane.control_points_map =
+        ExtendControlPoints(lane.control_points_map, selected_map, options_.lanes.fit);
+    lane.last_frame = frame.index;
+    lane.last_seen = frame.stamp;
+    if (lane.history.size() % options_.lanes.refit_every_n_frames == 0) {
+      RefitLane(&lane);
+      MergeLanes();
+    }
+  }
+}
+
+void Mapper::StartLane(int class_id, const LaneMeasurement& measurement,
+                       const std::vector<Eigen::Vector3d>& selected_map,
+                       const FrameRecord& frame) {
+  if (Extent(selected_map) < options_.lanes.min_new_lane_length_m) {
+    ++counters_.lane_observations_unused;
+    return;
+  }
+  const auto control_points = EstimateControlPoints(selected_map, options_.lanes.fit);
+  if (!control_points) {
+    ++counters_.lane_observations_unused;
+    return;
+  }
+  LaneElement lane;
+  lane.id = map_.next_id++;
+  lane.class_id = class_id;
+  lane.control_points_map = *control_points;
+  lane.fit_points_map = selected_map;
+  lane.fit_points_at_last_refit = selected_map.size();
+  lane.history.push_back(measurement);
+  lane.first_frame = lane.last_frame = frame.index;
+  lane.first_seen = lane.last_seen = frame.stamp;
+  map_.lanes.push_back(std::move(lane));
+  ++counters_.lanes_created;
+}
+
+void Mapper::RefitLane(LaneElement* lane) const {
+  if (lane->fit_points_at_last_refit == lane->fit_points_map.size()) return;
+  const auto control_points = EstimateControlPoints(lane->fit_points_map, options_.lanes.fit);
+  if (control_points) lane->control_points_map = *control_points;
+  lane->fit_points_at_last_refit = lane->fit_points_map.size();
+}
+
+void Mapper::MergeLanes() {
+  // Two lanes of one class that turn out to be one line (e.g. one was started while the
+  // other was not matched across a gap): the second's curve lies along the first.
+  for (std::size_t a = 0; a < map_.lanes.size(); ++a) {
+    for (std::size_t b = a + 1; b < map_.lanes.size();) {
+      LaneElement& first = map_.lanes[a];
+      LaneElement& second = map_.lanes[b];
+      LaneCandidate candidate;
+      candidate.class_id = second.class_id;
+      candidate.points_map = second.control_points_map;  // ordered along the lane
+      candidate.points_map.erase(candidate.points_map.begin());  // phantom ends out
+      candidate.points_map.pop_back();
+      if (candidate.points_map.size() < 2 ||
+          LaneAssociationCost(first, candidate, options_.association) < 0.0) {
+        ++b;
+        continue;
+      }
+      first.fit_points_map.insert(first.fit_points_map.end(), second.fit_points_map.begin(),
+                                  second.fit_points_map.end());
+      first.history.insert(first.history.end(), second.history.begin(), second.history.end());
+      std::sort(first.history.begin(), first.history.end(),
+                [](const LaneMeasurement& x, const LaneMeasurement& y) {
+                  return x.frame_index < y.frame_index;
+                });
+      first.first_frame = std::min(first.first_frame, second.first_frame);
+      first.last_frame = std::max(first.last_frame, second.last_frame);
+      first.first_seen = std::min(first.first_seen, second.first_seen);
+      first.last_seen = std::max(first.last_seen, second.last_seen);
+      first.fit_points_at_last_refit = 0;
+      RefitLane(&first);
+      map_.lanes.erase(map_.lanes.begin() + b);
+      ++counters_.lanes_merged;
+    }
+  }
+}
+
+void Mapper::DropSpurious(std::size_t frame_index) {
+  const std::size_t horizon = options_.association.spurious_after_frames;
+  auto spurious = [&](const auto& element) {
+    return element.history.size() == 1 && frame_index > element.last_frame + horizon;
+  };
+  const std::size_t before = map_.markings.size() + map_.lanes.size();
+  map_.markings.erase(std::remove_if(map_.markings.begin(), map_.markings.end(), spurious),
+                      map_.markings.end());
+  map_.lanes.erase(std::remove_if(map_.lanes.begin(), map_.lanes.end(), spurious),
+                   map_.lanes.end());
+  counters_.spurious_dropped += before - (map_.markings.size() + map_.lanes.size());
+}
+
+void Mapper::Reset() {
+  map_ = RoadMap();
+  last_stamp_ = -1.0;
+}
+
+VectorMap Mapper::ExportMap() const {
+  VectorMap out;
+  out.T_base_cam = T_base_cam_;
+  out.T_base_cam_initial = T_base_cam_initial_;
+  auto class_name = [this](int class_id) {
+    const ClassInfo* info = classes_.Find(class_id);
+    return info ? info->name : std::string("class_") + std::to_string(class_id);
+  };
+  for (const MarkingElement& element : map_.markings) {
+    MapMarking marking;
+    marking.id = element.id;
+    marking.class_id = element.class_id;
+    marking.class_name = class_name(element.class_id);
+    marking.corners_map = element.corners_map;
+    marking.observations = static_cast<int>(element.history.size());
+    marking.first_seen = element.first_seen;
+    marking.last_seen = element.last_seen;
+    out.markings.push_back(marking);
+  }
+  for (const LaneElement& element : map_.lanes) {
+    LaneElement refit = element;
+    RefitLane(&refit);
+    MapLane lane;
+    lane.id = element.id;
+    lane.class_id = element.class_id;
+    lane.class_name = class_name(element.class_id);
+    const ClassInfo* info = classes_.Find(element.class_id);
+    lane.style = info ? ToString(info->style) : "unknown";
+    lane.control_points_map = refit.control_points_map;
+    lane.observations = static_cast<int>(element.history.size());
+    lane.first_seen = element.first_seen;
+    lane.last_seen = element.last_seen;
+    out.lanes.push_back(std::move(lane));
+  }
+  for (const FrameRecord& frame : map_.frames) {
+    out.trajectory.push_back({frame.stamp, frame.T_map_base});
+  }
+  out.metadata["method"] = options_.method;
+  out.metadata["frames_received"] = counters_.frames_received;
+  out.metadata["frames_used"] = counters_.frames_used;
+  out.metadata["frames_skipped"] = counters_.frames_skipped;
+  return out;
+}
+
+}  // namespace ipm_road_mapper
