@@ -1,0 +1,219 @@
+#include "ipm_road_mapper/core/catmull_rom_spline.h"
+
+#include <algorithm>
+#include <cmath>
+#include <limits>
+#include <stdexcept>
+#include <string>
+#include <utility>
+
+namespace ipm_road_mapper {
+namespace {
+
+// 5-point Gauss-Legendre rule on [-1, 1]: exact for polynomials up to degree 9. The speed
+// |p'(u)| of a cubic is the square root of a quartic; two sub-intervals per integral keep the
+// error far below a millimeter even for strongly varying speed.
+constexpr double kGaussNodes[5] = {0.0, -0.5384693101056831, 0.5384693101056831,
+                                   -0.9061798459386640, 0.9061798459386640};
+constexpr double kGaussWeights[5] = {0.5688888888888889, 0.4786286704993665, 0.4786286704993665,
+                                     0.2369268850561891, 0.2369268850561891};
+constexpr int kQuadratureIntervals = 2;
+
+// Golden-section search iterations: shrinks a bracket of width <= 0.25 below 1e-9.
+constexpr int kGoldenIterations = 40;
+
+}  // namespace
+
+CatmullRomSpline::CatmullRomSpline(std::vector<Eigen::Vector3d> control_points)
+    : control_points_(std::move(control_points)) {
+  if (control_points_.size() < 4) {
+    throw std::invalid_argument("CatmullRomSpline needs at least 4 control points, got " +
+                                std::to_string(control_points_.size()));
+  }
+  for (const Eigen::Vector3d& c : control_points_) {
+    if (!c.allFinite()) throw std::invalid_argument("CatmullRomSpline: non-finite control point");
+  }
+  cumulative_length_.assign(NumSegments() + 1, 0.0);
+  for (int i = 0; i < NumSegments(); ++i) {
+    cumulative_length_[i + 1] = cumulative_length_[i] + SegmentArcLength(i, 1.0);
+  }
+}
+
+void CatmullRomSpline::Locate(double s, int* segment, double* u) const {
+  if (std::isnan(s)) throw std::invalid_argument("CatmullRomSpline: NaN parameter");
+  const double s_clamped = std::clamp(s, 0.0, static_cast<double>(NumSegments()));
+  *segment = std::min(static_cast<int>(std::floor(s_clamped)), NumSegments() - 1);
+  *u = s_clamped - *segment;
+}
+
+Eigen::Vector3d CatmullRomSpline::Evaluate(double s) const {
+  int i = 0;
+  double u = 0.0;
+  Locate(s, &i, &u);
+  const auto& c = control_points_;
+  return EvaluateSegment<double>(c[i], c[i + 1], c[i + 2], c[i + 3], u);
+}
+
+Eigen::Vector3d CatmullRomSpline::Derivative(double s) const {
+  int i = 0;
+  double u = 0.0;
+  Locate(s, &i, &u);
+  const auto& c = control_points_;
+  return SegmentDerivative<double>(c[i], c[i + 1], c[i + 2], c[i + 3], u);
+}
+
+double CatmullRomSpline::SegmentArcLength(int segment, double u) const {
+  // int_0^u |p'(v)| dv, composite Gauss-Legendre: on [a, b], v = m + h x with m the midpoint
+  // and h the half-width, so the integral is h * sum_k w_k |p'(m + h x_k)|.
+  const auto& c = control_points_;
+  const double h = 0.5 * u / kQuadratureIntervals;
+  double sum = 0.0;
+  for (int j = 0; j < kQuadratureIntervals; ++j) {
+    const double m = (2 * j + 1) * h;
+    for (int k = 0; k < 5; ++k) {
+      const double v = m + h * kGaussNodes[k];
+      sum += kGaussWeights[k] * SegmentDerivative<double>(c[segment], c[segment + 1],
+                                                          c[segment + 2], c[segment + 3], v)
+                                    .norm();
+    }
+  }
+  return h * sum;
+}
+
+double CatmullRomSpline::ArcLengthAt(double s) const {
+  int i = 0;
+  double u = 0.0;
+  Locate(s, &i, &u);
+  return cumulative_length_[i] + SegmentArcLength(i, u);
+}
+
+double CatmullRomSpline::ParameterAtArcLength(double arc_m) const {
+  if (std::isnan(arc_m)) throw std::invalid_argument("CatmullRomSpline: NaN arc length");
+  if (arc_m <= 0.0) return 0.0;
+  if (arc_m >= Length()) return NumSegments();
+  // Segment i with cumulative_length_[i] <= arc_m < cumulative_length_[i + 1].
+  const int i = std::clamp(static_cast<int>(std::upper_bound(cumulative_length_.begin(),
+                                                             cumulative_length_.end(), arc_m) -
+                                            cumulative_length_.begin()) -
+                               1,
+                           0, NumSegments() - 1);
+  const double target = arc_m - cumulative_length_[i];
+  const double segment_length = cumulative_length_[i + 1] - cumulative_length_[i];
+  if (segment_length <= 0.0) return i;
+  // Solve L(u) = target with Newton (L'(u) = |p'(u)|), safeguarded by the bracket [lo, hi]
+  // that always contains the root since L is monotone.
+  double lo = 0.0, hi = 1.0;
+  double u = target / segment_length;
+  const auto& c = control_points_;
+  for (int iteration = 0; iteration < 50; ++iteration) {
+    const double f = SegmentArcLength(i, u) - target;
+    if (std::abs(f) < 1e-10) break;
+    (f > 0.0 ? hi : lo) = u;
+    const double speed = SegmentDerivative<double>(c[i], c[i + 1], c[i + 2], c[i + 3], u).norm();
+    double next = speed > 1e-12 ? u - f / speed : 0.5 * (lo + hi);
+    if (!(next > lo && next < hi)) next = 0.5 * (lo + hi);
+    u = next;
+  }
+  return i + u;
+}
+
+std::vector<Eigen::Vector3d> CatmullRomSpline::SampleByArcLength(double spacing_m) const {
+  if (!(spacing_m > 0.0) || !std::isfinite(spacing_m)) {
+    throw std::invalid_argument("CatmullRomSpline::SampleByArcLength: spacing must be > 0");
+  }
+  const double length = Length();
+  std::vector<Eigen::Vector3d> samples;
+  // Regular samples strictly before the end (a sample within 1e-9 m of it would duplicate it).
+  const int count = static_cast<int>(std::ceil(length / spacing_m - 1e-9));
+  samples.reserve(count + 1);
+  for (int k = 0; k < count; ++k) {
+    samples.push_back(Evaluate(ParameterAtArcLength(k * spacing_m)));
+  }
+  samples.push_back(Evaluate(NumSegments()));
+  return samples;
+}
+
+double CatmullRomSpline::SquaredDistance(int segment, double u,
+                                         const Eigen::Vector3d& query) const {
+  const auto& c = control_points_;
+  return (EvaluateSegment<double>(c[segment], c[segment + 1], c[segment + 2], c[segment + 3], u) -
+          query)
+      .squaredNorm();
+}
+
+CatmullRomSpline::ClosestPoint CatmullRomSpline::FindClosest(const Eigen::Vector3d& query) const {
+  // 1) Coarse: per segment, sample u on a grid of step <= ~0.25 m of arc (at least 8 steps) and
+  //    keep the best sample. 2) A segment can only beat the best coarse sample d* if its own
+  //    best sample d_i satisfies d_i - step_i <= d* (any curve point lies within one step of a
+  //    sample), so only those are refined. 3) Refine by golden-section search on the bracket
+  //    of the two neighboring samples; the bracket ends are candidates too, which makes
+  //    queries beyond the ends land exactly on them.
+  struct Coarse {
+    double distance;
+    double u;
+    double step_u;
+    double step_m;
+  };
+  std::vector<Coarse> coarse(NumSegments());
+  double best_coarse = std::numeric_limits<double>::infinity();
+  for (int i = 0; i < NumSegments(); ++i) {
+    const double length = cumulative_length_[i + 1] - cumulative_length_[i];
+    const int steps = std::clamp(static_cast<int>(std::ceil(length / 0.25)), 8, 256);
+    Coarse& best = coarse[i];
+    best = {std::numeric_limits<double>::infinity(), 0.0, 1.0 / steps, 0.0};
+    Eigen::Vector3d previous = Evaluate(i);
+    for (int k = 0; k <= steps; ++k) {
+      const double u = static_cast<double>(k) / steps;
+      const Eigen::Vector3d p = Evaluate(i + u);
+      best.step_m = std::max(best.step_m, (p - previous).norm());
+      previous = p;
+      const double d = (p - query).norm();
+      if (d < best.distance) {
+        best.distance = d;
+        best.u = u;
+      }
+    }
+    best_coarse = std::min(best_coarse, best.distance);
+  }
+
+  ClosestPoint result;
+  double best_squared = std::numeric_limits<double>::infinity();
+  const double golden = 0.5 * (std::sqrt(5.0) - 1.0);
+  for (int i = 0; i < NumSegments(); ++i) {
+    // 1.5 x the chord between samples bounds the arc between them for gentle curves.
+    if (coarse[i].distance - 1.5 * coarse[i].step_m > best_coarse) continue;
+    double a = std::max(0.0, coarse[i].u - coarse[i].step_u);
+    double b = std::min(1.0, coarse[i].u + coarse[i].step_u);
+    const double bracket_a = a, bracket_b = b;
+    double x1 = b - golden * (b - a), x2 = a + golden * (b - a);
+    double f1 = SquaredDistance(i, x1, query), f2 = SquaredDistance(i, x2, query);
+    for (int iteration = 0; iteration < kGoldenIterations; ++iteration) {
+      if (f1 <= f2) {
+        b = x2, x2 = x1, f2 = f1;
+        x1 = b - golden * (b - a);
+        f1 = SquaredDistance(i, x1, query);
+      } else {
+        a = x1, x1 = x2, f1 = f2;
+        x2 = a + golden * (b - a);
+        f2 = SquaredDistance(i, x2, query);
+      }
+    }
+    const double candidates[3] = {bracket_a, 0.5 * (a + b), bracket_b};
+    for (double u : candidates) {
+      const double f = SquaredDistance(i, u, query);
+      if (f < best_squared) {
+        best_squared = f;
+        result.segment = i;
+        result.u = u;
+      }
+    }
+  }
+  result.s = result.segment + result.u;
+  const auto& c = control_points_;
+  const int i = result.segment;
+  result.point = EvaluateSegment<double>(c[i], c[i + 1], c[i + 2], c[i + 3], result.u);
+  result.distance_m = (result.point - query).norm();
+  return result;
+}
+
+}  // namespace ipm_road_mapper
