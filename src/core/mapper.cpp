@@ -22,7 +22,19 @@ Mapper::Mapper(MapperOptions options, ClassTable classes,
     : options_(std::move(options)),
       classes_(std::move(classes)),
       T_base_cam_initial_(T_base_cam_initial),
-      T_base_cam_(T_base_cam_initial) {}
+      T_base_cam_(T_base_cam_initial) {
+  if (options_.backend.enabled) backend_ = std::make_unique<Backend>(options_.backend);
+}
+
+Mapper::~Mapper() {
+  if (backend_) backend_->Stop();
+}
+
+BackendStats Mapper::backend_stats() const { return backend_ ? backend_->stats() : BackendStats(); }
+
+bool Mapper::LanesRefinedByBackend() const {
+  return backend_ && options_.backend.lane_residual != LaneResidual::kNone;
+}
 
 void Mapper::Skip(const std::string& reason, std::string* out) {
   const std::string key = reason.substr(0, reason.find(':'));
@@ -62,6 +74,8 @@ FrameStatus Mapper::ProcessFrame(const FrameInput& input, std::string* reason) {
     return FrameStatus::kSkipped;
   }
   last_stamp_ = input.stamp;
+  camera_ = input.camera;
+  ApplyBackendResults();
 
   const Ipm ipm(PinholeCamera(input.camera), T_base_cam_, options_.ipm.max_range_m);
   FrameObservations observations = ExtractObservations(
@@ -79,6 +93,9 @@ FrameStatus Mapper::ProcessFrame(const FrameInput& input, std::string* reason) {
   AddLanes(observations, frame);
   DropSpurious(frame.index);
   ++counters_.frames_used;
+  if (backend_ && counters_.frames_used % options_.backend.solve_every_n_frames == 0) {
+    backend_->Submit(BuildSnapshot());
+  }
   return FrameStatus::kUsed;
 }
 
@@ -116,14 +133,15 @@ void Mapper::AddMarkings(const FrameObservations& observations, const FrameRecor
       measurement.corners_base[i] = obs.corners_base[(i + shift) % 4];
     }
     element.history.push_back(measurement);
+    element.last_frame = frame.index;
+    element.last_seen = frame.stamp;
+    if (element.optimized) continue;  // the back end owns the estimate
     // Plain IPM estimate: the running mean of the observed corners in the map.
     const double n = static_cast<double>(element.history.size());
     for (int i = 0; i < 4; ++i) {
       element.corners_map[i] += (candidates[c].corners_map[(i + shift) % 4] -
                                  element.corners_map[i]) / n;
     }
-    element.last_frame = frame.index;
-    element.last_seen = frame.stamp;
   }
 }
 
@@ -182,13 +200,25 @@ void Mapper::AddLanes(const FrameObservations& observations, const FrameRecord& 
     }
     LaneElement& lane = map_.lanes[match[c]];
     lane.history.push_back(std::move(measurements[c]));
-    lane.fit_points_map.insert(lane.fit_points_map.end(), selected_map.begin(),
-                               selected_map.end());
-    lane.control_points_map =
+    std::vector<Eigen::Vector3d> grown =
         ExtendControlPoints(lane.control_points_map, selected_map, options_.lanes.fit);
+    // Growth at the start shifts the indices: find the old c2 again in the new vector
+    // (extension may re-place an end point, c1, but keeps the interior bit for bit). If it
+    // is not found, older back-end results for this lane no longer apply.
+    bool found = false;
+    for (std::size_t offset = 0; offset + 2 < grown.size() && offset < grown.size(); ++offset) {
+      if (grown[offset + 2] == lane.control_points_map[2]) {
+        lane.first_cp_index -= static_cast<std::int64_t>(offset);
+        found = true;
+        break;
+      }
+    }
+    if (!found) lane.first_cp_index -= 1000000;
+    lane.control_points_map = std::move(grown);
     lane.last_frame = frame.index;
     lane.last_seen = frame.stamp;
-    if (lane.history.size() % options_.lanes.refit_every_n_frames == 0) {
+    if (!LanesRefinedByBackend() &&
+        lane.history.size() % options_.lanes.refit_every_n_frames == 0) {
       RefitLane(&lane);
       MergeLanes();
     }
@@ -211,20 +241,38 @@ void Mapper::StartLane(int class_id, const LaneMeasurement& measurement,
   lane.id = map_.next_id++;
   lane.class_id = class_id;
   lane.control_points_map = *control_points;
-  lane.fit_points_map = selected_map;
-  lane.fit_points_at_last_refit = selected_map.size();
   lane.history.push_back(measurement);
+  lane.history_at_last_refit = 1;
   lane.first_frame = lane.last_frame = frame.index;
   lane.first_seen = lane.last_seen = frame.stamp;
   map_.lanes.push_back(std::move(lane));
   ++counters_.lanes_created;
 }
 
+std::vector<Eigen::Vector3d> Mapper::SelectedPointsMap(const LaneElement& lane) const {
+  const Ipm ipm(PinholeCamera(camera_), T_base_cam_, options_.ipm.max_range_m);
+  std::vector<Eigen::Vector3d> points;
+  for (const LaneMeasurement& m : lane.history) {
+    const Eigen::Isometry3d& T_map_base = map_.frames[m.frame_index].T_map_base;
+    for (std::size_t i = 0; i < m.points.size(); ++i) {
+      Eigen::Vector3d p_base;
+      if (m.selected[i] && ipm.PixelToGround(m.points[i].uv, &p_base) == IpmStatus::kOk) {
+        points.push_back(T_map_base * p_base);
+      }
+    }
+  }
+  return points;
+}
+
 void Mapper::RefitLane(LaneElement* lane) const {
-  if (lane->fit_points_at_last_refit == lane->fit_points_map.size()) return;
-  const auto control_points = EstimateControlPoints(lane->fit_points_map, options_.lanes.fit);
-  if (control_points) lane->control_points_map = *control_points;
-  lane->fit_points_at_last_refit = lane->fit_points_map.size();
+  if (lane->history_at_last_refit == lane->history.size()) return;
+  const auto control_points = EstimateControlPoints(SelectedPointsMap(*lane), options_.lanes.fit);
+  if (control_points) {
+    // A refit renumbers the control points: results of older windows no longer apply.
+    lane->control_points_map = *control_points;
+    lane->first_cp_index -= 1000000;
+  }
+  lane->history_at_last_refit = lane->history.size();
 }
 
 void Mapper::MergeLanes() {
@@ -244,8 +292,6 @@ void Mapper::MergeLanes() {
         ++b;
         continue;
       }
-      first.fit_points_map.insert(first.fit_points_map.end(), second.fit_points_map.begin(),
-                                  second.fit_points_map.end());
       first.history.insert(first.history.end(), second.history.begin(), second.history.end());
       std::sort(first.history.begin(), first.history.end(),
                 [](const LaneMeasurement& x, const LaneMeasurement& y) {
@@ -255,7 +301,7 @@ void Mapper::MergeLanes() {
       first.last_frame = std::max(first.last_frame, second.last_frame);
       first.first_seen = std::min(first.first_seen, second.first_seen);
       first.last_seen = std::max(first.last_seen, second.last_seen);
-      first.fit_points_at_last_refit = 0;
+      first.history_at_last_refit = 0;
       RefitLane(&first);
       map_.lanes.erase(map_.lanes.begin() + b);
       ++counters_.lanes_merged;
@@ -277,8 +323,95 @@ void Mapper::DropSpurious(std::size_t frame_index) {
 }
 
 void Mapper::Reset() {
+  if (backend_) {
+    backend_->Stop();  // results of the old map must not land in the new one
+    backend_ = std::make_unique<Backend>(options_.backend);
+  }
   map_ = RoadMap();
   last_stamp_ = -1.0;
+}
+
+void Mapper::Finish() {
+  if (!backend_ || map_.frames.empty()) return;
+  backend_->Submit(BuildSnapshot());
+  backend_->WaitIdle();
+  ApplyBackendResults();
+}
+
+WindowSnapshot Mapper::BuildSnapshot() {
+  WindowSnapshot snapshot;
+  snapshot.sequence = next_sequence_++;
+  snapshot.camera = camera_;
+  snapshot.T_base_cam = T_base_cam_;
+  snapshot.t_base_cam_prior = T_base_cam_initial_.translation();
+  const std::size_t window = static_cast<std::size_t>(options_.backend.window_frames);
+  const std::size_t first = map_.frames.size() > window ? map_.frames.size() - window : 0;
+  for (std::size_t i = first; i < map_.frames.size(); ++i) {
+    const FrameRecord& f = map_.frames[i];
+    snapshot.frames.push_back({f.index, f.T_map_base, f.T_map_base_odom});
+  }
+  for (const MarkingElement& m : map_.markings) {
+    if (m.last_frame < first) continue;  // outside the window: held fixed
+    WindowMarking wm{m.id, m.corners_map, {}};
+    for (const MarkingMeasurement& meas : m.history) {
+      if (meas.frame_index >= first) wm.measurements.push_back(meas);
+    }
+    snapshot.markings.push_back(std::move(wm));
+  }
+  for (const LaneElement& l : map_.lanes) {
+    if (l.last_frame < first) continue;
+    WindowLane wl{l.id, l.first_cp_index, l.control_points_map, {}};
+    for (const LaneMeasurement& meas : l.history) {
+      if (meas.frame_index >= first) wl.measurements.push_back(meas);
+    }
+    snapshot.lanes.push_back(std::move(wl));
+  }
+  return snapshot;
+}
+
+void Mapper::ApplyBackendResults() {
+  if (!backend_) return;
+  for (const auto& result : backend_->TakeResults()) {
+    if (!result->usable) {
+      ++counters_.results_rejected;
+      continue;
+    }
+    ApplyResult(*result);
+    ++counters_.results_applied;
+  }
+}
+
+void Mapper::ApplyResult(const WindowResult& result) {
+  T_base_cam_ = result.T_base_cam;  // fed forward to the next frames' IPM
+  for (const WindowFrame& f : result.frames) {
+    if (f.index < map_.frames.size()) map_.frames[f.index].T_map_base = f.T_map_base;
+  }
+  if (options_.backend.optimize_markings) {
+    for (const WindowMarking& wm : result.markings) {
+      for (MarkingElement& m : map_.markings) {
+        if (m.id != wm.id) continue;
+        m.corners_map = wm.corners_map;
+        m.optimized = true;
+      }
+    }
+  }
+  if (!LanesRefinedByBackend()) return;
+  for (const WindowLane& wl : result.lanes) {
+    for (LaneElement& lane : map_.lanes) {
+      if (lane.id != wl.id) continue;
+      const std::int64_t offset = wl.first_cp_index - lane.first_cp_index;
+      const std::int64_t n_result = static_cast<std::int64_t>(wl.control_points_map.size());
+      const std::int64_t n_lane = static_cast<std::int64_t>(lane.control_points_map.size());
+      for (std::int64_t j = 0; j < n_result; ++j) {
+        const std::int64_t k = j + offset;
+        if (k < 0 || k >= n_lane) continue;
+        // A phantom end of the snapshot that has since become a real point: keep the new one.
+        if ((j == 0 && k != 0) || (j == n_result - 1 && k != n_lane - 1)) continue;
+        lane.control_points_map[k] = wl.control_points_map[j];
+      }
+      lane.optimized = true;
+    }
+  }
 }
 
 VectorMap Mapper::ExportMap() const {
@@ -302,7 +435,10 @@ VectorMap Mapper::ExportMap() const {
   }
   for (const LaneElement& element : map_.lanes) {
     LaneElement refit = element;
-    RefitLane(&refit);
+    if (!LanesRefinedByBackend()) {
+      refit.history_at_last_refit = 0;  // re-IPM with the final extrinsic and poses
+      RefitLane(&refit);
+    }
     MapLane lane;
     lane.id = element.id;
     lane.class_id = element.class_id;
@@ -322,6 +458,9 @@ VectorMap Mapper::ExportMap() const {
   out.metadata["frames_received"] = counters_.frames_received;
   out.metadata["frames_used"] = counters_.frames_used;
   out.metadata["frames_skipped"] = counters_.frames_skipped;
+  out.metadata["backend"] = backend_ ? ToString(options_.backend.lane_residual) : "off";
+  out.metadata["backend_results_applied"] = counters_.results_applied;
+  out.metadata["backend_results_rejected"] = counters_.results_rejected;
   return out;
 }
 

@@ -62,6 +62,7 @@ MapperOptions LoadMapperOptions(OptionsReader reader) {
   o.lanes = LoadLaneOptions(reader.Child("lanes"));
   o.odometry = LoadOdometryOptions(reader.Child("odometry"));
   o.input = LoadInputOptions(reader.Child("input"));
+  o.backend = LoadBackendOptions(reader.Child("backend"));
   reader.RejectUnknownKeys();
   return o;
 }

@@ -13,7 +13,21 @@ OptionsReader::OptionsReader(YAML::Node node, std::string path)
   }
 }
 
-OptionsReader OptionsReader::FromFile(const std::string& file_path) {
+namespace {
+
+// Overlays `over` on `base`: maps merge key by key (recursively), anything else replaces.
+YAML::Node Merge(const YAML::Node& base, const YAML::Node& over) {
+  if (!base || !base.IsMap() || !over || !over.IsMap()) return YAML::Clone(over);
+  YAML::Node merged = YAML::Clone(base);
+  for (const auto& entry : over) {
+    const std::string key = entry.first.as<std::string>();
+    merged[key] = Merge(base[key], entry.second);
+  }
+  return merged;
+}
+
+YAML::Node LoadWithBase(const std::string& file_path, int depth) {
+  if (depth > 8) throw OptionsError(file_path + ": `base` chain too deep (a cycle?)");
   YAML::Node root;
   try {
     root = YAML::LoadFile(file_path);
@@ -22,7 +36,21 @@ OptionsReader OptionsReader::FromFile(const std::string& file_path) {
   } catch (const YAML::Exception& e) {
     throw OptionsError(file_path + ": malformed YAML: " + e.what());
   }
-  return OptionsReader(root, "");
+  if (!root.IsMap() || !root["base"]) return root;
+  std::string base_path = root["base"].as<std::string>();
+  if (!base_path.empty() && base_path[0] != '/') {
+    const std::size_t slash = file_path.find_last_of('/');
+    if (slash != std::string::npos) base_path = file_path.substr(0, slash + 1) + base_path;
+  }
+  YAML::Node overrides = YAML::Clone(root);
+  overrides.remove("base");
+  return Merge(LoadWithBase(base_path, depth + 1), overrides);
+}
+
+}  // namespace
+
+OptionsReader OptionsReader::FromFile(const std::string& file_path) {
+  return OptionsReader(LoadWithBase(file_path, 0), "");
 }
 
 bool OptionsReader::Has(const std::string& key) const {

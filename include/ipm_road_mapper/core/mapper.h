@@ -6,9 +6,11 @@
 #include <Eigen/Geometry>
 #include <cstdint>
 #include <map>
+#include <memory>
 #include <opencv2/core.hpp>
 #include <string>
 
+#include "ipm_road_mapper/core/backend.h"
 #include "ipm_road_mapper/core/class_table.h"
 #include "ipm_road_mapper/core/mapper_options.h"
 #include "ipm_road_mapper/core/pinhole_camera.h"
@@ -40,13 +42,19 @@ struct MapperCounters {
   std::uint64_t spurious_dropped = 0;
   std::uint64_t lanes_merged = 0;
   std::uint64_t lane_observations_unused = 0;  // unmatched and too short / unfit to start a lane
+  std::uint64_t results_applied = 0;           // back-end results merged into the map
+  std::uint64_t results_rejected = 0;          // unusable (solver failure, trust bound)
   std::uint64_t SkippedTotal() const;
 };
 
-// Front end of the mapper (the plain-IPM map; the back end refines it).
+// The mapper: the front end runs in the caller's thread; with options.backend.enabled it
+// hands sliding windows to the back end (an owned optimizer thread, or inline when
+// backend.synchronous) and merges its results at the start of the next frame.
 class Mapper {
  public:
   Mapper(MapperOptions options, ClassTable classes, const Eigen::Isometry3d& T_base_cam_initial);
+  ~Mapper();
+  Mapper(Mapper&&) = default;
 
   // Processes one frame. On kSkipped, *reason (if given) says why, e.g. "bad_mask: mask is
   // 640x480, camera is 1280x720"; the counter of that reason is incremented.
@@ -55,8 +63,15 @@ class Mapper {
   // Counts a frame the caller could not even build (e.g. no odometry at its stamp).
   void CountSkipped(const std::string& reason);
 
-  // The map as exported (map.json): lanes re-estimated from all their selected points.
+  // End of input: solves the last window, waits for the optimizer and merges its results.
+  void Finish();
+
+  // The map as exported (map.json). Lanes that no lane residual refines are re-estimated
+  // by g from all their selected pixels, re-IPMed with the current extrinsic and poses.
   VectorMap ExportMap() const;
+
+  // Optimizer statistics (zeros without a back end).
+  BackendStats backend_stats() const;
 
   // Drops the whole map and the frames, keeps options and extrinsic.
   void Reset();
@@ -77,7 +92,13 @@ class Mapper {
   void AddLanes(const FrameObservations& observations, const FrameRecord& frame);
   void StartLane(int class_id, const LaneMeasurement& measurement,
                  const std::vector<Eigen::Vector3d>& selected_map, const FrameRecord& frame);
+  // Selected pixels of every observation of the lane, IPMed now and put in the map.
+  std::vector<Eigen::Vector3d> SelectedPointsMap(const LaneElement& lane) const;
   void RefitLane(LaneElement* lane) const;
+  bool LanesRefinedByBackend() const;
+  WindowSnapshot BuildSnapshot();
+  void ApplyBackendResults();
+  void ApplyResult(const WindowResult& result);
   void MergeLanes();
   void DropSpurious(std::size_t frame_index);
   void Skip(const std::string& reason, std::string* out);
@@ -89,6 +110,9 @@ class Mapper {
   RoadMap map_;
   MapperCounters counters_;
   double last_stamp_ = -1.0;
+  CameraIntrinsics camera_;  // of the last used frame
+  std::uint64_t next_sequence_ = 1;
+  std::unique_ptr<Backend> backend_;
 };
 
 }  // namespace ipm_road_mapper

@@ -7,6 +7,7 @@
 #include <string>
 
 #include "ipm_road_mapper/core/association.h"
+#include "ipm_road_mapper/core/backend_options.h"
 #include "ipm_road_mapper/core/input_options.h"
 #include "ipm_road_mapper/core/instance_extraction.h"
 #include "ipm_road_mapper/core/ipm_uncertainty.h"
@@ -47,6 +48,7 @@ struct MapperOptions {
   LaneOptions lanes;
   OdometryOptions odometry;
   InputOptions input;
+  BackendOptions backend;
 };
 
 // Reads the `ipm` section; throws OptionsError naming the bad key.

@@ -36,6 +36,7 @@ struct MarkingElement {
   std::vector<MarkingMeasurement> history;
   std::size_t first_frame = 0, last_frame = 0;
   double first_seen = 0.0, last_seen = 0.0;
+  bool optimized = false;  // the back end owns the estimate from now on
   Eigen::Vector3d Center() const {
     return 0.25 * (corners_map[0] + corners_map[1] + corners_map[2] + corners_map[3]);
   }
@@ -54,11 +55,14 @@ struct LaneElement {
   std::uint64_t id = 0;
   int class_id = 0;
   std::vector<Eigen::Vector3d> control_points_map;  // Catmull-Rom, phantom ends included
-  std::vector<Eigen::Vector3d> fit_points_map;      // selected points, input of g
+  // Global index of control_points_map[0]; decreases as the lane grows at its start, so
+  // back-end results computed on an older copy can be applied point by point.
+  std::int64_t first_cp_index = 0;
   std::vector<LaneMeasurement> history;
   std::size_t first_frame = 0, last_frame = 0;
   double first_seen = 0.0, last_seen = 0.0;
-  std::size_t fit_points_at_last_refit = 0;
+  std::size_t history_at_last_refit = 0;
+  bool optimized = false;  // control points refined by a lane residual
 };
 
 // Elements and frames.

@@ -36,7 +36,9 @@ class OptionsReader {
   // `path` prefixes error messages ("" for the root).
   OptionsReader(YAML::Node node, std::string path);
 
-  // Loads a YAML file; throws OptionsError when it is missing or malformed.
+  // Loads a YAML file; throws OptionsError when it is missing or malformed. A top-level
+  // `base: <path>` (relative to the file) loads that file first and overlays this one on
+  // it, map by map, so a variant config states only what differs.
   static OptionsReader FromFile(const std::string& file_path);
 
   bool Has(const std::string& key) const;

@@ -1,0 +1,50 @@
+// Options of the back end (config section `backend`): what is optimized, the residual
+// weights and robust kernel, the sliding window, the alternation and the trust bound. The
+// ablation rows of the paper are combinations of these switches (config/ablations/).
+#pragma once
+
+#include <Eigen/Core>
+#include <string>
+
+#include "ipm_road_mapper/core/yaml_options.h"
+
+namespace ipm_road_mapper {
+
+// How lane control points are refined.
+enum class LaneResidual {
+  kNone,  // not optimized: control points re-estimated by g from re-IPMed selected points
+  kPsr,   // point-to-spline residual on IPM points (ablation)
+  kPpsr,  // projected point-to-spline residual on pixels (the paper's method)
+};
+
+const char* ToString(LaneResidual residual);
+
+struct BackendOptions {
+  bool enabled = true;                  // false: plain IPM front end only
+  bool synchronous = false;             // solve in the caller's thread (offline determinism)
+  bool optimize_extrinsic = true;       // R_base_cam, t_base_cam free in the map step
+  bool optimize_markings = true;        // marking corners free in the map step
+  bool optimize_z = true;               // z of corners and control points free
+  bool pose_update = true;              // run the pose-update step
+  LaneResidual lane_residual = LaneResidual::kPpsr;
+  int window_frames = 40;               // frames whose observations enter a solve
+  int solve_every_n_frames = 5;         // how often the front end hands a window over
+  int rounds = 2;                       // map+extrinsic <-> pose alternations per solve
+  int max_iterations = 10;              // Ceres iterations per step
+  int queue_size = 2;                   // windows waiting for the optimizer thread
+  double pixel_sigma_px = 2.0;          // corner and PPSR measurement sigma
+  double psr_sigma_m = 0.2;             // PSR (3D) measurement sigma
+  std::string robust_kernel = "huber";  // huber, cauchy or none
+  double robust_scale = 2.0;            // kernel scale in whitened units (sigmas)
+  Eigen::Vector3d translation_prior_sigma_m{0.02, 0.02, 0.02};
+  Eigen::Vector3d pose_prior_sigma_trans_m{0.3, 0.3, 0.05};   // base_link x, y, z
+  Eigen::Vector3d pose_prior_sigma_rot_rad{0.001, 0.001, 0.0052};  // roll, pitch, yaw
+  double max_extrinsic_change_rad = 2.0 * M_PI / 180.0;  // trust bound per solve
+  double max_extrinsic_change_m = 0.2;
+  int max_lane_points_per_observation = 12;  // PPSR/PSR pixels per lane observation
+};
+
+// Reads the `backend` section; throws OptionsError naming the bad key.
+BackendOptions LoadBackendOptions(OptionsReader reader);
+
+}  // namespace ipm_road_mapper

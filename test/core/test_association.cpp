@@ -1,0 +1,116 @@
+#include "ipm_road_mapper/core/association.h"
+
+#include <gtest/gtest.h>
+
+#include <cmath>
+
+namespace ipm_road_mapper {
+namespace {
+
+std::array<Eigen::Vector3d, 4> Rectangle(double cx, double cy, double length, double width) {
+  return {Eigen::Vector3d(cx - length / 2, cy - width / 2, 0),
+          Eigen::Vector3d(cx + length / 2, cy - width / 2, 0),
+          Eigen::Vector3d(cx + length / 2, cy + width / 2, 0),
+          Eigen::Vector3d(cx - length / 2, cy + width / 2, 0)};
+}
+
+MarkingElement Marking(int class_id, double cx, double cy) {
+  MarkingElement e;
+  e.class_id = class_id;
+  e.corners_map = Rectangle(cx, cy, 3.0, 1.0);
+  return e;
+}
+
+// A straight lane along x at lateral offset y, from x0 to x1, control points every 3 m
+// (phantom ends included).
+LaneElement StraightLane(int class_id, double y, double x0, double x1) {
+  LaneElement lane;
+  lane.class_id = class_id;
+  for (double x = x0 - 3.0; x <= x1 + 3.0 + 1e-9; x += 3.0) {
+    lane.control_points_map.emplace_back(x, y, 0.0);
+  }
+  return lane;
+}
+
+LaneCandidate LinePoints(int class_id, double y, double x0, double x1) {
+  LaneCandidate c;
+  c.class_id = class_id;
+  for (double x = x0; x <= x1 + 1e-9; x += 1.0) c.points_map.emplace_back(x, y, 0.0);
+  return c;
+}
+
+TEST(BestCyclicShift, FindsTheRotationOfTheCorners) {
+  const auto element = Rectangle(0, 0, 3, 1);
+  for (int shift = 0; shift < 4; ++shift) {
+    std::array<Eigen::Vector3d, 4> observed;
+    for (int i = 0; i < 4; ++i) observed[(i + shift) % 4] = element[i] + Eigen::Vector3d(0.1, 0, 0);
+    double mean = -1.0;
+    EXPECT_EQ(BestCyclicShift(element, observed, &mean), shift);
+    EXPECT_NEAR(mean, 0.1, 1e-12);
+  }
+}
+
+TEST(AssociateMarkings, MatchesNearestOfSameClassWithinGate) {
+  const std::vector<MarkingElement> elements = {Marking(10, 0, 0), Marking(10, 10, 0),
+                                                Marking(20, 5, 0)};
+  std::vector<MarkingCandidate> candidates(4);
+  candidates[0] = {10, Rectangle(9.6, 0.2, 3, 1)};  // near element 1
+  candidates[1] = {20, Rectangle(0.3, 0, 3, 1)};    // near element 0, but wrong class
+  candidates[2] = {10, Rectangle(5.0, 0, 3, 1)};    // 5 m from both class-10 elements
+  candidates[3] = {20, Rectangle(5.5, 0.5, 3, 1)};  // element 2
+  AssociationOptions options;
+  const auto match = AssociateMarkings(elements, candidates, options);
+  EXPECT_EQ(match, (std::vector<int>{1, -1, -1, 2}));
+}
+
+TEST(AssociateMarkings, OneToOneWithinAFrame) {
+  const std::vector<MarkingElement> elements = {Marking(10, 0, 0)};
+  std::vector<MarkingCandidate> candidates = {{10, Rectangle(0.8, 0, 3, 1)},
+                                              {10, Rectangle(0.2, 0, 3, 1)}};
+  const auto match = AssociateMarkings(elements, candidates, AssociationOptions());
+  EXPECT_EQ(match, (std::vector<int>{-1, 0}));  // the closer one wins, the other is new
+}
+
+TEST(AssociateLanes, MatchesByLateralDistanceAndClass) {
+  const std::vector<LaneElement> lanes = {StraightLane(2, 0.0, 0, 30),
+                                          StraightLane(2, 3.5, 0, 30),
+                                          StraightLane(1, -3.5, 0, 30)};
+  const std::vector<LaneCandidate> candidates = {
+      LinePoints(2, 3.3, 5, 25), LinePoints(2, 0.2, 5, 25), LinePoints(2, -3.5, 5, 25),
+      LinePoints(2, 1.75, 5, 25)};  // halfway between two lanes: beyond the 0.8 m gate
+  const auto match = AssociateLanes(lanes, candidates, AssociationOptions());
+  EXPECT_EQ(match, (std::vector<int>{1, 0, -1, -1}));
+}
+
+TEST(AssociateLanes, PointsPastTheEndExtendTheLane) {
+  const std::vector<LaneElement> lanes = {StraightLane(2, 0.0, 0, 30)};
+  // Starts 2 m before the lane's end and runs 20 m past it, 0.1 m off the line.
+  const auto match =
+      AssociateLanes(lanes, {LinePoints(2, 0.1, 28, 50)}, AssociationOptions());
+  EXPECT_EQ(match[0], 0);
+  // Far past the end (beyond lane_max_end_gap_m): a new lane.
+  const auto far = AssociateLanes(lanes, {LinePoints(2, 0.0, 60, 80)}, AssociationOptions());
+  EXPECT_EQ(far[0], -1);
+}
+
+TEST(AssociateLanes, RejectsCrossingDirection) {
+  const std::vector<LaneElement> lanes = {StraightLane(2, 0.0, 0, 30)};
+  LaneCandidate crossing;
+  crossing.class_id = 2;
+  for (double y = -5; y <= 5; y += 1.0) crossing.points_map.emplace_back(15.0, y, 0.0);
+  EXPECT_LT(LaneAssociationCost(lanes[0], crossing, AssociationOptions()), 0.0);
+}
+
+TEST(AssociationOptions, RejectsUnknownAndBadKeys) {
+  EXPECT_THROW(LoadAssociationOptions(OptionsReader(YAML::Load("lane_gate: 1.0"), "association")),
+               OptionsError);
+  EXPECT_THROW(
+      LoadAssociationOptions(OptionsReader(YAML::Load("marking_gate_m: -1"), "association")),
+      OptionsError);
+  const auto o =
+      LoadAssociationOptions(OptionsReader(YAML::Load("marking_gate_m: 2.5"), "association"));
+  EXPECT_DOUBLE_EQ(o.marking_gate_m, 2.5);
+}
+
+}  // namespace
+}  // namespace ipm_road_mapper

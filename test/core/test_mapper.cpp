@@ -1,0 +1,218 @@
+// The core Mapper end to end on rendered masks: elements are created once and re-observed,
+// lanes grow, spurious elements are dropped, and every kind of bad input is skipped with a
+// counted reason without touching the map.
+#include "ipm_road_mapper/core/mapper.h"
+
+#include <gtest/gtest.h>
+
+#include <opencv2/imgproc.hpp>
+
+#include "ipm_road_mapper/core/ipm.h"
+
+namespace ipm_road_mapper {
+namespace {
+
+CameraIntrinsics TestCamera() {
+  CameraIntrinsics c;
+  c.width = 1280;
+  c.height = 720;
+  c.fx = c.fy = 1000.0;
+  c.cx = 640.0;
+  c.cy = 360.0;
+  return c;
+}
+
+// Camera 1.5 m high, 1.5 m ahead of base_link, pitched down 5 degrees.
+Eigen::Isometry3d TestExtrinsic() {
+  Eigen::Matrix3d R_base_optical;
+  R_base_optical << 0, 0, 1, -1, 0, 0, 0, -1, 0;
+  Eigen::Isometry3d T = Eigen::Isometry3d::Identity();
+  T.linear() = RotationFromRpy(0.0, 5.0 * M_PI / 180.0, 0.0) * R_base_optical;
+  T.translation() = Eigen::Vector3d(1.5, 0.0, 1.5);
+  return T;
+}
+
+ClassTable TestClasses() {
+  return ClassTable::Load(OptionsReader(YAML::Load(R"(
+classes:
+  - {id: 2, name: lane_white_dashed, kind: lane, style: dashed}
+  - {id: 10, name: arrow_straight, kind: marking}
+)"), ""));
+}
+
+// Fills the ground polygon (map frame, z = 0) seen from T_map_base into the mask.
+void FillGround(const std::vector<Eigen::Vector3d>& polygon_map, const Eigen::Isometry3d& T_map_base,
+                int value, cv::Mat* mask) {
+  const Ipm ipm(PinholeCamera(TestCamera()), TestExtrinsic(), 100.0);
+  std::vector<cv::Point> pixels;
+  for (std::size_t i = 0; i < polygon_map.size(); ++i) {
+    const Eigen::Vector3d a = polygon_map[i], b = polygon_map[(i + 1) % polygon_map.size()];
+    for (int k = 0; k < 20; ++k) {
+      Eigen::Vector2d uv;
+      const Eigen::Vector3d p_base = T_map_base.inverse() * (a + (b - a) * (k / 20.0));
+      if (!ipm.BaseToPixel(p_base, &uv)) return;
+      pixels.emplace_back(static_cast<int>(std::lround(uv.x())), static_cast<int>(std::lround(uv.y())));
+    }
+  }
+  cv::fillPoly(*mask, std::vector<std::vector<cv::Point>>{pixels}, cv::Scalar(value));
+}
+
+std::vector<Eigen::Vector3d> Rect(double x0, double x1, double y0, double y1) {
+  return {{x0, y0, 0}, {x1, y0, 0}, {x1, y1, 0}, {x0, y1, 0}};
+}
+
+Eigen::Isometry3d PoseAt(double x) {
+  Eigen::Isometry3d T = Eigen::Isometry3d::Identity();
+  T.translation().x() = x;
+  return T;
+}
+
+// A frame with an arrow at x in [20, 23] m, y in [-0.3, 0.3] m, and a dashed lane at
+// y = 1.8 m (3 m dashes, 6 m period), seen from base_link at x_vehicle.
+FrameInput RoadFrame(double stamp, double x_vehicle, bool with_arrow = true) {
+  FrameInput in;
+  in.stamp = stamp;
+  in.camera = TestCamera();
+  in.T_map_base_odom = PoseAt(x_vehicle);
+  in.mask = cv::Mat::zeros(720, 1280, CV_16UC1);
+  for (double x = 0.0; x < 120.0; x += 6.0) {
+    if (x < x_vehicle + 4.0 || x > x_vehicle + 35.0) continue;
+    FillGround(Rect(x, x + 3.0, 1.725, 1.875), in.T_map_base_odom, 2001, &in.mask);
+  }
+  if (with_arrow && x_vehicle + 6.0 < 20.0) {
+    FillGround(Rect(20.0, 23.0, -0.3, 0.3), in.T_map_base_odom, 10001, &in.mask);
+  }
+  return in;
+}
+
+// The front end alone (the back end has its own tests).
+Mapper MakeMapper() {
+  MapperOptions options;
+  options.backend.enabled = false;
+  return Mapper(options, TestClasses(), TestExtrinsic());
+}
+
+TEST(Mapper, ReobservedMarkingIsOneElementAtTheRightPlace) {
+  Mapper mapper = MakeMapper();
+  for (int k = 0; k < 10; ++k) {
+    ASSERT_EQ(mapper.ProcessFrame(RoadFrame(100.0 + 0.05 * k, 0.5 * k)), FrameStatus::kUsed);
+  }
+  ASSERT_EQ(mapper.map().markings.size(), 1u);
+  const MarkingElement& arrow = mapper.map().markings[0];
+  EXPECT_EQ(arrow.history.size(), 10u);
+  EXPECT_NEAR(arrow.Center().x(), 21.5, 0.1);
+  EXPECT_NEAR(arrow.Center().y(), 0.0, 0.05);
+  // Each measurement's pixel corners are stored in the element's corner order: the
+  // first corner of every frame maps to the same ground corner.
+  const Ipm ipm(PinholeCamera(TestCamera()), TestExtrinsic(), 100.0);
+  for (const MarkingMeasurement& m : arrow.history) {
+    Eigen::Vector3d p_base;
+    ASSERT_EQ(ipm.PixelToGround(m.corners_uv[0], &p_base), IpmStatus::kOk);
+    const Eigen::Vector3d p_map = mapper.map().frames[m.frame_index].T_map_base * p_base;
+    EXPECT_LT((p_map - arrow.corners_map[0]).head<2>().norm(), 0.15);
+  }
+}
+
+TEST(Mapper, DashedLaneIsOneGrowingSpline) {
+  Mapper mapper = MakeMapper();
+  for (int k = 0; k < 60; ++k) mapper.ProcessFrame(RoadFrame(100.0 + 0.05 * k, 1.0 * k, false));
+  const VectorMap map = mapper.ExportMap();
+  ASSERT_EQ(map.lanes.size(), 1u);
+  const auto& cps = map.lanes[0].control_points_map;
+  ASSERT_GE(cps.size(), 4u);
+  double x_min = 1e9, x_max = -1e9;
+  for (std::size_t i = 1; i + 1 < cps.size(); ++i) {
+    EXPECT_NEAR(cps[i].y(), 1.8, 0.1);
+    x_min = std::min(x_min, cps[i].x());
+    x_max = std::max(x_max, cps[i].x());
+  }
+  EXPECT_LT(x_min, 12.0);  // first dashes seen from x = 0
+  EXPECT_GT(x_max, 80.0);  // grown as the vehicle drove 59 m
+}
+
+TEST(Mapper, MarkingSeenOnceIsDroppedAsSpurious) {
+  Mapper mapper = MakeMapper();
+  mapper.ProcessFrame(RoadFrame(100.0, 0.0));
+  EXPECT_EQ(mapper.map().markings.size(), 1u);
+  for (int k = 1; k <= 12; ++k) mapper.ProcessFrame(RoadFrame(100.0 + 0.05 * k, 0.0, false));
+  EXPECT_TRUE(mapper.map().markings.empty());
+  EXPECT_EQ(mapper.counters().spurious_dropped, 1u);
+}
+
+TEST(Mapper, BadInputIsSkippedCountedAndLeavesTheMap) {
+  Mapper mapper = MakeMapper();
+  for (int k = 0; k < 3; ++k) mapper.ProcessFrame(RoadFrame(100.0 + 0.05 * k, 0.5 * k));
+  const std::size_t markings = mapper.map().markings.size();
+  const std::size_t frames = mapper.map().frames.size();
+  ASSERT_EQ(markings, 1u);
+
+  std::string reason;
+  FrameInput wrong_size = RoadFrame(101.0, 2.0);
+  wrong_size.mask = cv::Mat::zeros(480, 640, CV_16UC1);
+  EXPECT_EQ(mapper.ProcessFrame(wrong_size, &reason), FrameStatus::kSkipped);
+  EXPECT_NE(reason.find("bad_mask"), std::string::npos) << reason;
+
+  FrameInput wrong_encoding = RoadFrame(101.1, 2.0);
+  wrong_encoding.mask = cv::Mat::zeros(720, 1280, CV_8UC1);
+  EXPECT_EQ(mapper.ProcessFrame(wrong_encoding, &reason), FrameStatus::kSkipped);
+
+  FrameInput nan_pose = RoadFrame(101.2, 2.0);
+  nan_pose.T_map_base_odom.translation().x() = std::nan("");
+  EXPECT_EQ(mapper.ProcessFrame(nan_pose, &reason), FrameStatus::kSkipped);
+  EXPECT_NE(reason.find("bad_pose"), std::string::npos) << reason;
+
+  FrameInput back_in_time = RoadFrame(99.0, 2.0);
+  EXPECT_EQ(mapper.ProcessFrame(back_in_time, &reason), FrameStatus::kSkipped);
+  EXPECT_NE(reason.find("time_jump"), std::string::npos) << reason;
+
+  FrameInput bad_camera = RoadFrame(101.3, 2.0);
+  bad_camera.camera.fx = 0.0;
+  EXPECT_EQ(mapper.ProcessFrame(bad_camera, &reason), FrameStatus::kSkipped);
+
+  FrameInput nan_stamp = RoadFrame(101.4, 2.0);
+  nan_stamp.stamp = std::nan("");
+  EXPECT_EQ(mapper.ProcessFrame(nan_stamp, &reason), FrameStatus::kSkipped);
+
+  EXPECT_EQ(mapper.map().markings.size(), markings);
+  EXPECT_EQ(mapper.map().frames.size(), frames);
+  const auto& skipped = mapper.counters().frames_skipped;
+  EXPECT_EQ(skipped.at("bad_mask"), 2u);
+  EXPECT_EQ(skipped.at("bad_pose"), 1u);
+  EXPECT_EQ(skipped.at("time_jump"), 1u);
+  EXPECT_EQ(skipped.at("bad_camera"), 1u);
+  EXPECT_EQ(skipped.at("bad_stamp"), 1u);
+
+  // Still maps after the bad frames.
+  EXPECT_EQ(mapper.ProcessFrame(RoadFrame(102.0, 2.0)), FrameStatus::kUsed);
+  EXPECT_EQ(mapper.map().markings.size(), 1u);
+}
+
+TEST(Mapper, AbsurdMasksAreBounded) {
+  Mapper mapper = MakeMapper();
+  FrameInput all_foreground = RoadFrame(100.0, 0.0);
+  all_foreground.mask.setTo(cv::Scalar(10001));
+  EXPECT_EQ(mapper.ProcessFrame(all_foreground), FrameStatus::kUsed);
+  EXPECT_TRUE(mapper.map().markings.empty());  // touches the border: truncated
+
+  FrameInput confetti = RoadFrame(100.1, 0.0);
+  for (int i = 0; i < 10000; ++i) {
+    const int value = 10000 + (i % 30000);  // many classes, many instances
+    confetti.mask.at<std::uint16_t>(200 + (i / 1280) * 2 % 500, i % 1280) =
+        static_cast<std::uint16_t>(value);
+  }
+  EXPECT_EQ(mapper.ProcessFrame(confetti), FrameStatus::kUsed);
+  const ExtractionCounters& c = mapper.counters().extraction;
+  EXPECT_GT(c.dropped_instance_limit + c.dropped_unknown_class + c.dropped_tiny, 0u);
+}
+
+TEST(Mapper, ResetDropsTheMapButKeepsMapping) {
+  Mapper mapper = MakeMapper();
+  for (int k = 0; k < 3; ++k) mapper.ProcessFrame(RoadFrame(100.0 + 0.05 * k, 0.5 * k));
+  mapper.Reset();
+  EXPECT_TRUE(mapper.map().markings.empty());
+  EXPECT_TRUE(mapper.map().frames.empty());
+  EXPECT_EQ(mapper.ProcessFrame(RoadFrame(50.0, 0.0)), FrameStatus::kUsed);  // time restarts
+}
+
+}  // namespace
+}  // namespace ipm_road_mapper
