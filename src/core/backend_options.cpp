@@ -66,6 +66,8 @@ BackendOptions LoadBackendOptions(OptionsReader reader) {
   reader.Read<double>("robust_scale", &o.robust_scale, CheckPositive);
   o.translation_prior_sigma_m =
       ReadTriple(&reader, "translation_prior_sigma_m", o.translation_prior_sigma_m, 1.0);
+  o.rotation_prior_sigma_rad =
+      ReadTriple(&reader, "rotation_prior_sigma_deg", o.rotation_prior_sigma_rad, kDegToRad);
   o.pose_prior_sigma_trans_m =
       ReadTriple(&reader, "pose_prior_sigma_trans_m", o.pose_prior_sigma_trans_m, 1.0);
   o.pose_prior_sigma_rot_rad =
@@ -76,6 +78,7 @@ BackendOptions LoadBackendOptions(OptionsReader reader) {
   reader.Read<double>("max_extrinsic_change_m", &o.max_extrinsic_change_m, CheckPositive);
   reader.Read<int>("max_lane_points_per_observation", &o.max_lane_points_per_observation,
                    CheckPositiveInt);
+  reader.Read<double>("ground_height_sigma_m", &o.ground_height_sigma_m, CheckNonNegative);
   reader.RejectUnknownKeys();
   return o;
 }

@@ -344,6 +344,7 @@ WindowSnapshot Mapper::BuildSnapshot() {
   snapshot.camera = camera_;
   snapshot.T_base_cam = T_base_cam_;
   snapshot.t_base_cam_prior = T_base_cam_initial_.translation();
+  snapshot.q_base_cam_prior = Eigen::Quaterniond(T_base_cam_initial_.linear());
   const std::size_t window = static_cast<std::size_t>(options_.backend.window_frames);
   const std::size_t first = map_.frames.size() > window ? map_.frames.size() - window : 0;
   for (std::size_t i = first; i < map_.frames.size(); ++i) {

@@ -10,10 +10,12 @@
 #include "ipm_road_mapper/core/ipm.h"
 #include "ipm_road_mapper/core/rigid_transform.h"
 #include "ipm_road_mapper/core/residuals/corner_reprojection_residual.h"
+#include "ipm_road_mapper/core/residuals/ground_height_prior_residual.h"
 #include "ipm_road_mapper/core/residuals/point_anchor_residual.h"
 #include "ipm_road_mapper/core/residuals/pose_prior_residual.h"
 #include "ipm_road_mapper/core/residuals/ppsr_residual.h"
 #include "ipm_road_mapper/core/residuals/psr_residual.h"
+#include "ipm_road_mapper/core/residuals/rotation_prior_residual.h"
 #include "ipm_road_mapper/core/residuals/translation_prior_residual.h"
 
 namespace ipm_road_mapper {
@@ -175,6 +177,55 @@ ceres::Solver::Summary Solve(const BackendOptions& options, ceres::Problem* prob
   return summary;
 }
 
+// The pose (of the window's frames) from which `p_map` was seen closest, among `frames`.
+const Eigen::Isometry3d* ClosestFrame(const WindowSnapshot& snapshot,
+                                      const std::vector<std::size_t>& frame_indices,
+                                      const WindowState& state, const Eigen::Vector3d& p_map) {
+  const Eigen::Isometry3d* best = nullptr;
+  double best_distance = 1e18;
+  for (std::size_t index : frame_indices) {
+    const auto slot = state.slot_of_frame.find(index);
+    if (slot == state.slot_of_frame.end()) continue;
+    const Eigen::Isometry3d& T = snapshot.frames[slot->second].T_map_base;
+    const double d = (T.translation() - p_map).head<2>().norm();
+    if (d < best_distance) {
+      best_distance = d;
+      best = &T;
+    }
+  }
+  return best;
+}
+
+// Ground-height priors for every free map point (see ground_height_prior_residual.h).
+void AddGroundHeightPriors(const WindowSnapshot& snapshot, const BackendOptions& options,
+                           WindowState* state, ceres::Problem* problem) {
+  for (std::size_t m = 0; m < snapshot.markings.size() && options.optimize_markings; ++m) {
+    std::vector<std::size_t> frames;
+    for (const auto& meas : snapshot.markings[m].measurements) frames.push_back(meas.frame_index);
+    for (auto& c : state->corners[m]) {
+      if (!problem->HasParameterBlock(c.data())) continue;
+      if (const Eigen::Isometry3d* T = ClosestFrame(snapshot, frames, *state, c)) {
+        problem->AddResidualBlock(
+            residuals::GroundHeightPriorResidual::Create(*T, options.ground_height_sigma_m),
+            nullptr, c.data());
+      }
+    }
+  }
+  if (options.lane_residual == LaneResidual::kNone) return;
+  for (std::size_t l = 0; l < snapshot.lanes.size(); ++l) {
+    std::vector<std::size_t> frames;
+    for (const auto& meas : snapshot.lanes[l].measurements) frames.push_back(meas.frame_index);
+    for (auto& c : state->control_points[l]) {
+      if (!problem->HasParameterBlock(c.data())) continue;
+      if (const Eigen::Isometry3d* T = ClosestFrame(snapshot, frames, *state, c)) {
+        problem->AddResidualBlock(
+            residuals::GroundHeightPriorResidual::Create(*T, options.ground_height_sigma_m),
+            nullptr, c.data());
+      }
+    }
+  }
+}
+
 // The map + extrinsic step. Returns the summary.
 ceres::Solver::Summary MapStep(const WindowSnapshot& snapshot, const BackendOptions& options,
                                WindowState* state, int* blocks) {
@@ -188,6 +239,9 @@ ceres::Solver::Summary MapStep(const WindowSnapshot& snapshot, const BackendOpti
   problem.AddResidualBlock(residuals::TranslationPriorResidual::Create(
                                snapshot.t_base_cam_prior, options.translation_prior_sigma_m),
                            nullptr, state->extrinsic.t);
+  problem.AddResidualBlock(residuals::RotationPriorResidual::Create(
+                               snapshot.q_base_cam_prior, options.rotation_prior_sigma_rad),
+                           nullptr, state->extrinsic.q);
   const bool lanes_free = options.lane_residual != LaneResidual::kNone;
   for (auto& cps : state->control_points) {
     for (auto& c : cps) {
@@ -195,6 +249,9 @@ ceres::Solver::Summary MapStep(const WindowSnapshot& snapshot, const BackendOpti
       problem.AddResidualBlock(
           residuals::PointAnchorResidual::Create(c, kControlPointAnchorSigmaM), nullptr, c.data());
     }
+  }
+  if (options.ground_height_sigma_m > 0.0 && options.optimize_z) {
+    AddGroundHeightPriors(snapshot, options, state, &problem);
   }
   for (auto& corners : state->corners) {
     for (auto& c : corners) {

@@ -37,11 +37,18 @@ struct BackendOptions {
   std::string robust_kernel = "huber";  // huber, cauchy or none
   double robust_scale = 2.0;            // kernel scale in whitened units (sigmas)
   Eigen::Vector3d translation_prior_sigma_m{0.02, 0.02, 0.02};
+  // Prior of the extrinsic rotation on its rough value, per base_link axis (roll, pitch,
+  // yaw): roll is unobservable on straight roads, pitch and yaw are observable.
+  Eigen::Vector3d rotation_prior_sigma_rad{0.1 * M_PI / 180.0, 3.0 * M_PI / 180.0,
+                                           3.0 * M_PI / 180.0};
   Eigen::Vector3d pose_prior_sigma_trans_m{0.3, 0.3, 0.05};   // base_link x, y, z
   Eigen::Vector3d pose_prior_sigma_rot_rad{0.001, 0.001, 0.0052};  // roll, pitch, yaw
   double max_extrinsic_change_rad = 2.0 * M_PI / 180.0;  // trust bound per solve
   double max_extrinsic_change_m = 0.2;
   int max_lane_points_per_observation = 12;  // PPSR/PSR pixels per lane observation
+  // Height of map points in base_link of their closest observing frame ~ 0 (weak prior
+  // that fixes the extrinsic roll about the direction of travel; 0 disables it).
+  double ground_height_sigma_m = 0.2;
 };
 
 // Reads the `backend` section; throws OptionsError naming the bad key.

@@ -52,6 +52,7 @@ struct WindowSnapshot {
   CameraIntrinsics camera;
   Eigen::Isometry3d T_base_cam = Eigen::Isometry3d::Identity();
   Eigen::Vector3d t_base_cam_prior = Eigen::Vector3d::Zero();  // t_0 of the translation prior
+  Eigen::Quaterniond q_base_cam_prior = Eigen::Quaterniond::Identity();  // rotation prior
   std::vector<WindowFrame> frames;  // sorted by index
   std::vector<WindowMarking> markings;
   std::vector<WindowLane> lanes;

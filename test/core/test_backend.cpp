@@ -1,0 +1,257 @@
+// The back end on synthetic geometry: a window solve recovers a perturbed extrinsic and the
+// marking corners, the pose step pulls noisy poses toward the truth, PPSR refines a lane,
+// and the optimizer thread queues, drops, publishes and stops as documented.
+#include "ipm_road_mapper/core/backend.h"
+
+#include <gtest/gtest.h>
+
+#include <random>
+
+#include "ipm_road_mapper/core/ipm.h"
+#include "ipm_road_mapper/core/rigid_transform.h"
+
+namespace ipm_road_mapper {
+namespace {
+
+constexpr double kDeg = M_PI / 180.0;
+
+CameraIntrinsics TestCamera() {
+  CameraIntrinsics c;
+  c.width = 1280;
+  c.height = 720;
+  c.fx = c.fy = 1000.0;
+  c.cx = 640.0;
+  c.cy = 360.0;
+  return c;
+}
+
+Eigen::Isometry3d Extrinsic(double pitch_deg, double yaw_deg) {
+  Eigen::Matrix3d R_base_optical;
+  R_base_optical << 0, 0, 1, -1, 0, 0, 0, -1, 0;
+  Eigen::Isometry3d T = Eigen::Isometry3d::Identity();
+  T.linear() = RotationFromRpy(0.0, pitch_deg * kDeg, yaw_deg * kDeg) * R_base_optical;
+  T.translation() = Eigen::Vector3d(1.5, 0.0, 1.5);
+  return T;
+}
+
+Eigen::Isometry3d Pose(double x, double y, double yaw) {
+  Eigen::Isometry3d T = Eigen::Isometry3d::Identity();
+  T.linear() = RotationFromRpy(0, 0, yaw);
+  T.translation() = Eigen::Vector3d(x, y, 0);
+  return T;
+}
+
+// A straight drive past markings at x = 20, 32, 44 m (alternating sides), 20 frames, with
+// corner measurements projected through the TRUE extrinsic and TRUE poses; the snapshot
+// starts from a rough extrinsic, odometry poses with white noise, and corners initialized
+// by flat IPM with the rough extrinsic from the first frame that saw them.
+struct Scene {
+  WindowSnapshot snapshot;
+  Eigen::Isometry3d T_base_cam_true = Extrinsic(5.0, 0.0);
+  std::vector<Eigen::Isometry3d> poses_true;
+  std::vector<std::array<Eigen::Vector3d, 4>> corners_true;
+};
+
+Scene MakeScene(double pose_noise_m, unsigned seed) {
+  Scene scene;
+  std::mt19937 rng(seed);
+  std::normal_distribution<double> noise(0.0, 1.0);
+  const PinholeCamera camera(TestCamera());
+  WindowSnapshot& s = scene.snapshot;
+  s.camera = TestCamera();
+  s.T_base_cam = Extrinsic(5.6, 0.4);  // 0.6 deg pitch, 0.4 deg yaw off
+  s.t_base_cam_prior = scene.T_base_cam_true.translation();
+  s.q_base_cam_prior = Eigen::Quaterniond(s.T_base_cam.linear());  // the rough value
+  for (int k = 0; k < 20; ++k) {
+    const Eigen::Isometry3d T_true = Pose(1.0 * k, 0.0, 0.002 * k);
+    scene.poses_true.push_back(T_true);
+    WindowFrame f;
+    f.index = 100 + k;
+    f.T_map_base_odom = T_true * Pose(pose_noise_m * noise(rng), pose_noise_m * noise(rng),
+                                      0.1 * kDeg * pose_noise_m / 0.3 * noise(rng));
+    f.T_map_base = f.T_map_base_odom;
+    s.frames.push_back(f);
+  }
+  const std::vector<Eigen::Vector2d> centers = {{14, 1.2}, {22, -1.5}, {30, 0.8}};
+  for (std::size_t m = 0; m < centers.size(); ++m) {
+    const Eigen::Vector2d c = centers[m];
+    std::array<Eigen::Vector3d, 4> corners = {
+        Eigen::Vector3d(c.x() - 1.5, c.y() - 0.4, 0.05 * m),
+        Eigen::Vector3d(c.x() + 1.5, c.y() - 0.4, 0.05 * m),
+        Eigen::Vector3d(c.x() + 1.5, c.y() + 0.4, 0.05 * m),
+        Eigen::Vector3d(c.x() - 1.5, c.y() + 0.4, 0.05 * m)};
+    scene.corners_true.push_back(corners);
+    WindowMarking wm;
+    wm.id = m + 1;
+    bool initialized = false;
+    for (int k = 0; k < 20; ++k) {
+      const Eigen::Isometry3d T_cam_map =
+          (scene.poses_true[k] * scene.T_base_cam_true).inverse();
+      MarkingMeasurement meas;
+      meas.frame_index = 100 + k;
+      bool visible = true;
+      for (int i = 0; i < 4; ++i) {
+        Eigen::Vector2d uv;
+        const Eigen::Vector3d p_cam = T_cam_map * corners[i];
+        visible = visible && p_cam.z() > 4.0 && p_cam.z() < 30.0 &&
+                  camera.Project<double>(p_cam, &uv) && camera.InImage(uv);
+        meas.corners_uv[i] = uv + 0.5 * Eigen::Vector2d(noise(rng), noise(rng));
+      }
+      if (!visible) continue;
+      wm.measurements.push_back(meas);
+      if (!initialized) {
+        const Ipm ipm(camera, s.T_base_cam, 100.0);
+        for (int i = 0; i < 4; ++i) {
+          Eigen::Vector3d p_base;
+          EXPECT_EQ(ipm.PixelToGround(meas.corners_uv[i], &p_base), IpmStatus::kOk);
+          wm.corners_map[i] = s.frames[k].T_map_base * p_base;
+        }
+        initialized = true;
+      }
+    }
+    EXPECT_GE(wm.measurements.size(), 5u) << "marking " << m << " barely visible";
+    s.markings.push_back(wm);
+  }
+  return scene;
+}
+
+double MeanCornerError(const WindowResult& r, const Scene& scene) {
+  double sum = 0.0;
+  int n = 0;
+  for (std::size_t m = 0; m < r.markings.size(); ++m) {
+    for (int i = 0; i < 4; ++i, ++n) {
+      sum += (r.markings[m].corners_map[i] - scene.corners_true[m][i]).norm();
+    }
+  }
+  return sum / n;
+}
+
+// Mean translation error along one axis of the true base frame (0: longitudinal, 1: lateral).
+double MeanPoseError(const std::vector<WindowFrame>& frames, const Scene& scene, bool odom,
+                     int axis) {
+  double sum = 0.0;
+  for (std::size_t k = 0; k < frames.size(); ++k) {
+    const auto& T = odom ? frames[k].T_map_base_odom : frames[k].T_map_base;
+    const Eigen::Vector3d e_base = scene.poses_true[k].linear().transpose() *
+                                   (T.translation() - scene.poses_true[k].translation());
+    sum += std::abs(e_base(axis));
+  }
+  return sum / frames.size();
+}
+
+BackendOptions SyncOptions() {
+  BackendOptions o;
+  o.synchronous = true;
+  o.rounds = 3;
+  o.max_iterations = 30;
+  return o;
+}
+
+TEST(SolveWindow, RecoversExtrinsicAndCornersWithExactPoses) {
+  const Scene scene = MakeScene(0.0, 1);
+  BackendOptions options = SyncOptions();
+  options.pose_update = false;
+  const double before = MeanCornerError(SolveWindow(scene.snapshot, [] {
+    BackendOptions o = SyncOptions();
+    o.max_iterations = 1;
+    o.optimize_extrinsic = o.optimize_markings = false;
+    o.pose_update = false;
+    return o;
+  }()), scene);
+  const WindowResult r = SolveWindow(scene.snapshot, options);
+  ASSERT_TRUE(r.usable) << r.reason;
+  const double rot_err_deg = RotationAngleBetween(r.T_base_cam, scene.T_base_cam_true) / kDeg;
+  const Eigen::Vector3d rpy_err =
+      RpyFromRotation(r.T_base_cam.linear() * scene.T_base_cam_true.linear().transpose()) / kDeg;
+  std::cout << "extrinsic rpy error (base frame, deg) " << rpy_err.transpose() << "; t error "
+            << (r.T_base_cam.translation() - scene.T_base_cam_true.translation()).transpose()
+            << "\n";
+  std::cout << "extrinsic error " << rot_err_deg << " deg (from 0.72), corners " << before
+            << " -> " << MeanCornerError(r, scene) << " m, " << r.solve_time_s * 1e3 << " ms\n";
+  EXPECT_LT(rot_err_deg, 0.05);
+  EXPECT_LT(MeanCornerError(r, scene), 0.08);
+  EXPECT_GT(before, 0.2);  // the scene is hard enough for the check to mean something
+}
+
+TEST(SolveWindow, PoseStepPullsNoisyPosesTowardTheTruth) {
+  // The pose step in isolation: extrinsic known and held, markings initialized from the
+  // noisy poses; alternating map and pose steps must bring the poses closer to the truth.
+  Scene scene = MakeScene(0.3, 2);
+  scene.snapshot.T_base_cam = scene.T_base_cam_true;
+  BackendOptions options = SyncOptions();
+  options.optimize_extrinsic = false;
+  options.rounds = 4;
+  const WindowResult r = SolveWindow(scene.snapshot, options);
+  ASSERT_TRUE(r.usable) << r.reason;
+  const double lateral_in = MeanPoseError(scene.snapshot.frames, scene, true, 1);
+  const double lateral_out = MeanPoseError(r.frames, scene, false, 1);
+  const double longitudinal_in = MeanPoseError(scene.snapshot.frames, scene, true, 0);
+  const double longitudinal_out = MeanPoseError(r.frames, scene, false, 0);
+  std::cout << "pose error lateral " << lateral_in << " -> " << lateral_out
+            << " m, longitudinal " << longitudinal_in << " -> " << longitudinal_out << " m\n";
+  // Markings 10-30 m ahead constrain the lateral position strongly (0.3 m ~ 20 px) and the
+  // longitudinal one weakly (0.3 m ~ 2 px): the lateral error must drop clearly. KNOWN
+  // DEFECT (issue 5): the longitudinal error grows (0.21 -> 0.31 m on this scene); this
+  // bound only keeps it from getting worse until that is fixed.
+  EXPECT_LT(lateral_out, 0.5 * lateral_in);
+  EXPECT_LT(longitudinal_out, 1.6 * longitudinal_in);
+}
+
+TEST(SolveWindow, TrustBoundRejectsAWildExtrinsicChange) {
+  const Scene scene = MakeScene(0.0, 3);
+  BackendOptions options = SyncOptions();
+  options.max_extrinsic_change_rad = 0.05 * kDeg;  // the needed 0.7 deg is beyond it
+  const WindowResult r = SolveWindow(scene.snapshot, options);
+  EXPECT_FALSE(r.usable);
+  EXPECT_NE(r.reason.find("trust"), std::string::npos) << r.reason;
+}
+
+TEST(SolveWindow, ZHeldWhenNotOptimized) {
+  const Scene scene = MakeScene(0.0, 4);
+  BackendOptions options = SyncOptions();
+  options.optimize_z = false;
+  const WindowResult r = SolveWindow(scene.snapshot, options);
+  for (std::size_t m = 0; m < r.markings.size(); ++m) {
+    for (int i = 0; i < 4; ++i) {
+      EXPECT_DOUBLE_EQ(r.markings[m].corners_map[i].z(), scene.snapshot.markings[m].corners_map[i].z());
+    }
+  }
+}
+
+TEST(Backend, ThreadSolvesQueuedWindowsAndStops) {
+  const Scene scene = MakeScene(0.0, 5);
+  BackendOptions options = SyncOptions();
+  options.synchronous = false;
+  options.queue_size = 1;
+  Backend backend(options);
+  for (int i = 0; i < 5; ++i) {
+    WindowSnapshot s = scene.snapshot;
+    s.sequence = i + 1;
+    backend.Submit(std::move(s));  // never blocks; a full queue drops its oldest window
+  }
+  backend.WaitIdle();
+  const auto results = backend.TakeResults();
+  const BackendStats stats = backend.stats();
+  EXPECT_EQ(stats.submitted, 5u);
+  EXPECT_EQ(stats.solved + stats.dropped_queue_full, 5u);
+  ASSERT_FALSE(results.empty());
+  EXPECT_EQ(results.back()->sequence, 5u);  // the newest window is always solved
+  EXPECT_TRUE(backend.TakeResults().empty());
+  backend.Stop();
+  backend.Stop();  // idempotent
+}
+
+TEST(Backend, DestructorJoinsWithWorkPending) {
+  const Scene scene = MakeScene(0.0, 6);
+  BackendOptions options = SyncOptions();
+  options.synchronous = false;
+  {
+    Backend backend(options);
+    backend.Submit(scene.snapshot);
+    backend.Submit(scene.snapshot);
+  }  // must not hang or crash
+  SUCCEED();
+}
+
+}  // namespace
+}  // namespace ipm_road_mapper
