@@ -462,6 +462,20 @@ VectorMap Mapper::ExportMap() const {
   out.metadata["backend"] = backend_ ? ToString(options_.backend.lane_residual) : "off";
   out.metadata["backend_results_applied"] = counters_.results_applied;
   out.metadata["backend_results_rejected"] = counters_.results_rejected;
+  if (backend_) {
+    const BackendStats stats = backend_->stats();
+    std::vector<double> times = stats.solve_times_s;
+    std::sort(times.begin(), times.end());
+    auto quantile = [&times](double q) {
+      return times.empty() ? 0.0 : times[std::min(times.size() - 1,
+                                                   static_cast<std::size_t>(q * times.size()))];
+    };
+    out.metadata["backend_solves"] = stats.solved;
+    out.metadata["backend_dropped_queue_full"] = stats.dropped_queue_full;
+    out.metadata["backend_solve_time_p50_s"] = quantile(0.5);
+    out.metadata["backend_solve_time_p95_s"] = quantile(0.95);
+    out.metadata["backend_solve_time_max_s"] = times.empty() ? 0.0 : times.back();
+  }
   return out;
 }
 

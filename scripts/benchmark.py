@@ -1,0 +1,206 @@
+#!/usr/bin/env python3
+"""The project's benchmark: ablations x synthetic scenarios, printed as the paper's tables.
+
+1. map accuracy (marking / lane APE) per scenario for IPM, PGO-IPM, IPM(+PS), Ours(-),
+   Ours(+PS), Ours(+PSR), Ours(+PPSR);
+2. the pose update at odometry noise levels 0.1/0.1 .. 0.5/0.5 (m / deg);
+3. the extrinsic and IPM-grid error before and after, and the map with the true extrinsic;
+4. storage per km; plus speed (mapping frames/s, window solve time p50/p95).
+Figures are measured here and printed; nothing is asserted (tests assert loose bounds).
+"""
+import argparse
+import json
+import math
+import os
+import subprocess
+import sys
+import time
+
+ABLATIONS = [("IPM", "ipm"), ("PGO-IPM", "pgo_ipm"), ("IPM (+PS)", "ipm_ps"),
+             ("Ours (-)", "ours_minus"), ("Ours (+PS)", "ours_ps"),
+             ("Ours (+PSR)", "ours_psr"), ("Ours (+PPSR)", "ours_ppsr")]
+NOISE_LEVELS = [0.1, 0.2, 0.3, 0.4, 0.5]
+
+
+def run(cmd, log):
+    with open(log, "w") as f:
+        result = subprocess.run(cmd, stdout=f, stderr=subprocess.STDOUT)
+    if result.returncode != 0:
+        sys.exit("benchmark: failed (%d): %s\n  log: %s" % (result.returncode, " ".join(cmd), log))
+
+
+def generate(args, scenario_path, out):
+    key = "%s-%s" % (os.path.getmtime(scenario_path), os.path.getmtime(os.path.join(args.bin, "generate_drive")))
+    stamp = os.path.join(out, ".key")
+    if os.path.exists(stamp) and open(stamp).read() == key:
+        return
+    os.makedirs(out, exist_ok=True)
+    run([os.path.join(args.bin, "generate_drive"), "--scenario", scenario_path, "--seed", "1",
+         "--out", out], os.path.join(out, "generate.log"))
+    open(stamp, "w").write(key)
+
+
+def map_and_evaluate(args, drive, config, out):
+    os.makedirs(out, exist_ok=True)
+    start = time.time()
+    run([os.path.join(args.bin, "map_from_bag"), "--bag", os.path.join(drive, "drive.bag"),
+         "--config", config, "--out", out], os.path.join(out, "map.log"))
+    wall = time.time() - start
+    run([os.path.join(args.bin, "evaluate_map"), "--map", os.path.join(out, "map.json"),
+         "--ground-truth", os.path.join(drive, "ground_truth.json"), "--json",
+         os.path.join(out, "metrics.json")], os.path.join(out, "evaluate.log"))
+    metrics = json.load(open(os.path.join(out, "metrics.json")))
+    metadata = json.load(open(os.path.join(out, "map.json"))).get("metadata", {})
+    metrics["_wall_s"] = wall
+    metrics["_metadata"] = metadata
+    return metrics
+
+
+def fmt(value, digits=3):
+    if value is None or (isinstance(value, float) and math.isnan(value)):
+        return "-"
+    return ("%." + str(digits) + "f") % value
+
+
+def table(title, header, rows):
+    print("\n" + title)
+    widths = [max(len(str(h)), *(len(str(r[i])) for r in rows)) for i, h in enumerate(header)]
+    line = " | ".join(str(h).ljust(w) for h, w in zip(header, widths))
+    print(line)
+    print("-+-".join("-" * w for w in widths))
+    for r in rows:
+        print(" | ".join(str(c).ljust(w) for c, w in zip(r, widths)))
+
+
+def overlay(path, text):
+    with open(path, "w") as f:
+        f.write(text)
+    return path
+
+
+def true_extrinsic_config(args, drive, out):
+    gt = json.load(open(os.path.join(drive, "ground_truth.json")))
+    pose = gt["T_base_cam_true"]
+    qx, qy, qz, qw = pose["q_xyzw"]
+    # R = Rz(yaw) Ry(pitch) Rx(roll), as RpyFromRotation in rigid_transform.cpp.
+    r20 = 2 * (qx * qz - qw * qy)
+    r21 = 2 * (qy * qz + qw * qx)
+    r22 = 1 - 2 * (qx * qx + qy * qy)
+    r10 = 2 * (qx * qy + qw * qz)
+    r00 = 1 - 2 * (qy * qy + qz * qz)
+    rpy = [math.degrees(math.atan2(r21, r22)), math.degrees(math.asin(max(-1, min(1, -r20)))),
+           math.degrees(math.atan2(r10, r00))]
+    return overlay(os.path.join(out, "true_extrinsic.yaml"),
+                   "base: %s\nmethod: ours_ppsr_true_extrinsic\ninput:\n  extrinsic: {xyz: %s, rpy_deg: %s}\n"
+                   % (os.path.join(args.repo, "config/mapper.yaml"), json.dumps(pose["t"]),
+                      json.dumps(rpy)))
+
+
+def main():
+    parser = argparse.ArgumentParser(description=__doc__.split("\n")[0])
+    parser.add_argument("--repo", required=True)
+    parser.add_argument("--bin", required=True)
+    parser.add_argument("--scenarios", default="public_road,port,hilly")
+    parser.add_argument("--quick", action="store_true", help="default scenario, no noise sweep")
+    parser.add_argument("--out", default=None)
+    args = parser.parse_args()
+    out_root = args.out or os.path.join(args.repo, "out", "benchmark")
+    scenarios = ["public_road"] if args.quick else args.scenarios.split(",")
+
+    results = {}
+    for scenario in scenarios:
+        drive = os.path.join(out_root, "drives", scenario)
+        generate(args, os.path.join(args.repo, "config", "scenarios", scenario + ".yaml"), drive)
+        for label, config in ABLATIONS:
+            print("[benchmark] %s / %s" % (scenario, label), file=sys.stderr)
+            results[(scenario, config)] = map_and_evaluate(
+                args, drive, os.path.join(args.repo, "config", "ablations", config + ".yaml"),
+                os.path.join(out_root, "maps", scenario, config))
+
+    header = ["method"]
+    for s in scenarios:
+        header += ["%s marking" % s, "%s lane" % s]
+    rows = []
+    for label, config in ABLATIONS:
+        row = [label]
+        for s in scenarios:
+            m = results[(s, config)]
+            row += [fmt(m.get("marking_ape_mean_m")) + " +- " + fmt(m.get("marking_ape_std_m")),
+                    fmt(m.get("lane_ape_mean_m")) + " +- " + fmt(m.get("lane_ape_std_m"))]
+        rows.append(row)
+    table("Table 1. Map accuracy, APE (m), mean +- std", header, rows)
+
+    rows = []
+    for label, config in ABLATIONS:
+        for s in scenarios:
+            m = results[(s, config)]
+            rows.append([label, s, fmt(m.get("marking_recall"), 2), m.get("marking_duplicates"),
+                         fmt(m.get("lane_f1"), 2)])
+    table("Table 1b. Completeness", ["method", "scenario", "marking recall", "duplicates",
+                                     "lane F1"], rows)
+
+    if not args.quick:
+        rows = []
+        base = os.path.join(args.repo, "config", "scenarios", "public_road.yaml")
+        for level in NOISE_LEVELS:
+            name = "public_road_noise_%.1f" % level
+            drive = os.path.join(out_root, "drives", name)
+            os.makedirs(drive, exist_ok=True)
+            scenario = overlay(os.path.join(drive, "scenario.yaml"),
+                               "base: %s\nname: %s\nodometry: {xy_std_m: %.2f, yaw_std_deg: %.2f}\n"
+                               % (base, name, level, level))
+            generate(args, scenario, drive)
+            print("[benchmark] pose update at %.1f m / %.1f deg" % (level, level), file=sys.stderr)
+            m = map_and_evaluate(args, drive,
+                                 os.path.join(args.repo, "config", "ablations", "ours_ppsr.yaml"),
+                                 os.path.join(out_root, "maps", name, "ours_ppsr"))
+            rows.append(["%.1f / %.1f" % (level, level), fmt(m.get("pose_trans_err_m_input")),
+                         fmt(m.get("pose_trans_err_m")), fmt(m.get("pose_rot_err_deg_input")),
+                         fmt(m.get("pose_rot_err_deg")), fmt(m.get("marking_ape_mean_m"))])
+        table("Table 2. Pose update (Ours +PPSR) on public_road", [
+            "noise m / deg", "trans in (m)", "trans out (m)", "rot in (deg)", "rot out (deg)",
+            "marking APE (m)"], rows)
+
+    rows = []
+    for s in scenarios:
+        drive = os.path.join(out_root, "drives", s)
+        m = results[(s, "ours_ppsr")]
+        t = map_and_evaluate(args, drive, true_extrinsic_config(args, drive, os.path.join(out_root, "maps", s)),
+                             os.path.join(out_root, "maps", s, "true_extrinsic"))
+        rows.append([s, fmt(m.get("extrinsic_rot_err_deg_initial")), fmt(m.get("extrinsic_rot_err_deg")),
+                     fmt(m.get("extrinsic_trans_err_m_initial")), fmt(m.get("extrinsic_trans_err_m")),
+                     fmt(m.get("ipm_grid_err_m_initial")), fmt(m.get("ipm_grid_err_m")),
+                     fmt(t.get("marking_ape_mean_m")), fmt(t.get("lane_ape_mean_m"))])
+    table("Table 3. Extrinsic (Ours +PPSR): before -> after, and the map with the true extrinsic",
+          ["scenario", "rot before (deg)", "rot after (deg)", "trans before (m)",
+           "trans after (m)", "IPM grid before (m)", "IPM grid after (m)",
+           "true-extrinsic marking APE", "true-extrinsic lane APE"], rows)
+
+    rows = []
+    for s in scenarios:
+        for label, config in (("IPM", "ipm"), ("Ours (+PPSR)", "ours_ppsr")):
+            m = results[(s, config)]
+            rows.append([s, label, fmt(m.get("map_bytes_per_km"), 0), fmt(m.get("control_points_per_km"), 1)])
+    table("Table 4. Storage", ["scenario", "method", "map bytes / km", "control points / km"], rows)
+
+    rows = []
+    for s in scenarios:
+        for label, config in ABLATIONS:
+            m = results[(s, config)]
+            md = m["_metadata"]
+            frames = md.get("frames_used", 0) or 0
+            rows.append([s, label, fmt(frames / m["_wall_s"] if m["_wall_s"] > 0 else None, 0),
+                         fmt(1e3 * md["backend_solve_time_p50_s"], 1) if "backend_solve_time_p50_s" in md else "-",
+                         fmt(1e3 * md["backend_solve_time_p95_s"], 1) if "backend_solve_time_p95_s" in md else "-",
+                         md.get("backend_solves", "-"), md.get("backend_results_rejected", "-")])
+    table("Speed (map_from_bag wall clock incl. bag reading; one core for the solver)",
+          ["scenario", "method", "frames/s", "solve p50 (ms)", "solve p95 (ms)", "solves",
+           "rejected"], rows)
+    json.dump({"%s/%s" % k: {kk: vv for kk, vv in v.items() if not kk.startswith("_")}
+               for k, v in results.items()}, open(os.path.join(out_root, "results.json"), "w"),
+              indent=1)
+    print("\n[benchmark] raw results: %s" % os.path.join(out_root, "results.json"))
+
+
+if __name__ == "__main__":
+    main()

@@ -1,0 +1,13 @@
+#!/usr/bin/env bash
+# Runs the ablations on the synthetic scenarios and prints the paper-style tables
+# (scripts/benchmark.py). Drives are cached in out/benchmark/drives. Options are passed on:
+#   bash scripts/benchmark.sh [--scenarios public_road,port,hilly] [--quick]
+set -eo pipefail
+repo="$(cd "$(dirname "${BASH_SOURCE[0]}")/.." && pwd)"
+build="${IRM_BUILD_DIR:-$repo/.build}"
+export PATH="/usr/bin:/bin:/usr/sbin:/sbin:$PATH"
+export ROS_HOME="$build/ros_home"
+bash "$repo/scripts/setup.sh"
+# shellcheck disable=SC1091
+source "$build/devel/setup.bash"
+exec /usr/bin/python3 "$repo/scripts/benchmark.py" --repo "$repo" --bin "$build/devel/lib/ipm_road_mapper" "$@"
