@@ -17,10 +17,17 @@ Eigen::Matrix3d Hat(const Eigen::Vector3d& v) {
 Eigen::Matrix3d LeftJacobianSo3(const Eigen::Vector3d& omega) {
   const double theta = omega.norm();
   const Eigen::Matrix3d W = Hat(omega);
-  if (theta < 1e-8) return Eigen::Matrix3d::Identity() + 0.5 * W + W * W / 6.0;
   const double t2 = theta * theta;
-  return Eigen::Matrix3d::Identity() + (1.0 - std::cos(theta)) / t2 * W +
-         (theta - std::sin(theta)) / (t2 * theta) * W * W;
+  // Both coefficients cancel catastrophically for small theta when written as above (at
+  // theta = 1e-8, 1 - cos(theta) rounds to 0, dropping the first-order term). Instead,
+  // (1 - cos t)/t^2 = 2 sin^2(t/2)/t^2, which has no cancellation, and (t - sin t)/t^3 uses
+  // its Taylor series below 1e-2 (truncation error < 1e-17).
+  if (theta < 1e-12) return Eigen::Matrix3d::Identity() + 0.5 * W + W * W / 6.0;
+  const double half_sinc = std::sin(0.5 * theta) / (0.5 * theta);
+  const double a = 0.5 * half_sinc * half_sinc;
+  const double b = theta < 1e-2 ? 1.0 / 6.0 - t2 / 120.0 + t2 * t2 / 5040.0
+                                : (theta - std::sin(theta)) / (t2 * theta);
+  return Eigen::Matrix3d::Identity() + a * W + b * W * W;
 }
 
 }  // namespace
@@ -96,6 +103,8 @@ const char* ToString(PoseLookupStatus status) {
       return "after_last_odometry";
     case PoseLookupStatus::kGapTooLarge:
       return "odometry_gap";
+    case PoseLookupStatus::kInvalidStamp:
+      return "invalid_stamp";
   }
   return "unknown";
 }
@@ -115,6 +124,9 @@ bool PoseBuffer::Add(const StampedPose& pose) {
 
 PoseLookupStatus PoseBuffer::Lookup(double stamp, Eigen::Isometry3d* T_map_base) const {
   if (poses_.empty()) return PoseLookupStatus::kEmpty;
+  // A NaN stamp fails every comparison below; the bracketing search would then run past
+  // the end of the buffer.
+  if (std::isnan(stamp)) return PoseLookupStatus::kInvalidStamp;
   if (stamp <= poses_.front().stamp) {
     if (poses_.front().stamp - stamp > extrapolation_tolerance_s_) {
       return PoseLookupStatus::kBeforeFirst;

@@ -4,6 +4,7 @@
 #pragma once
 
 #include <Eigen/Core>
+#include <Eigen/LU>  // Matrix::inverse() in UndistortToNormalized
 #include <array>
 #include <cmath>
 #include <string>

@@ -50,10 +50,11 @@ struct StampedPose {
 // Why a pose could not be interpolated at a requested stamp.
 enum class PoseLookupStatus {
   kOk,
-  kEmpty,          // no pose at all
-  kBeforeFirst,    // stamp earlier than the first pose by more than the tolerance
-  kAfterLast,      // stamp later than the last pose by more than the tolerance
-  kGapTooLarge,    // bracketing poses farther apart than the allowed gap
+  kEmpty,         // no pose at all
+  kBeforeFirst,   // stamp earlier than the first pose by more than the tolerance
+  kAfterLast,     // stamp later than the last pose by more than the tolerance
+  kGapTooLarge,   // bracketing poses farther apart than the allowed gap
+  kInvalidStamp,  // the requested stamp is NaN
 };
 
 // Human-readable name of a lookup status (for logs and skip counters).
