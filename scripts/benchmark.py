@@ -1,4 +1,4 @@
-#!/usr/bin/env python3
+#!/usr/bin/python3
 """The project's benchmark: ablations x synthetic scenarios, printed as the paper's tables.
 
 1. map accuracy (marking / lane APE) per scenario for IPM, PGO-IPM, IPM(+PS), Ours(-),

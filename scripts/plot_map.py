@@ -1,4 +1,4 @@
-#!/usr/bin/env python3
+#!/usr/bin/python3
 """Plot a vectorized road map against the ground truth of its drive.
 
     plot_map.py --map map.json --ground-truth ground_truth.json \

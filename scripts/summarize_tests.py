@@ -1,4 +1,4 @@
-#!/usr/bin/env python3
+#!/usr/bin/python3
 """Counts test cases after a ctest run and prints "N passed, N failed".
 
 A gtest or rostest ctest entry counts its test cases (from the XML it writes under

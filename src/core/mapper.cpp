@@ -189,13 +189,22 @@ void Mapper::AddLanes(const FrameObservations& observations, const FrameRecord& 
     measurements.push_back(std::move(measurement));
   }
   const std::vector<int> match = AssociateLanes(map_.lanes, candidates, options_.association);
+  bool merge_due = false;
   for (std::size_t c = 0; c < candidates.size(); ++c) {
     std::vector<Eigen::Vector3d> selected_map;
     for (std::size_t i = 0; i < candidates[c].points_map.size(); ++i) {
       if (measurements[c].selected[i]) selected_map.push_back(candidates[c].points_map[i]);
     }
     if (match[c] < 0) {
-      StartLane(candidates[c].class_id, measurements[c], selected_map, frame);
+      // The start gate looks at every point PS would accept by score: the N best alone
+      // may all lie on the nearest dash of a dashed line, shorter than the gate.
+      std::vector<Eigen::Vector3d> usable_map;
+      for (std::size_t i = 0; i < candidates[c].points_map.size(); ++i) {
+        if (measurements[c].points[i].score <= options_.lanes.max_selected_score_m2) {
+          usable_map.push_back(candidates[c].points_map[i]);
+        }
+      }
+      StartLane(candidates[c].class_id, measurements[c], selected_map, usable_map, frame);
       continue;
     }
     LaneElement& lane = map_.lanes[match[c]];
@@ -220,19 +229,23 @@ void Mapper::AddLanes(const FrameObservations& observations, const FrameRecord& 
     if (!LanesRefinedByBackend() &&
         lane.history.size() % options_.lanes.refit_every_n_frames == 0) {
       RefitLane(&lane);
-      MergeLanes();
+      merge_due = true;
     }
   }
+  // After the loop: merging erases lanes, which would invalidate the indices in `match`.
+  if (merge_due) MergeLanes();
 }
 
 void Mapper::StartLane(int class_id, const LaneMeasurement& measurement,
                        const std::vector<Eigen::Vector3d>& selected_map,
+                       const std::vector<Eigen::Vector3d>& usable_map,
                        const FrameRecord& frame) {
-  if (Extent(selected_map) < options_.lanes.min_new_lane_length_m) {
+  if (Extent(usable_map) < options_.lanes.min_new_lane_length_m) {
     ++counters_.lane_observations_unused;
     return;
   }
-  const auto control_points = EstimateControlPoints(selected_map, options_.lanes.fit);
+  auto control_points = EstimateControlPoints(selected_map, options_.lanes.fit);
+  if (!control_points) control_points = EstimateControlPoints(usable_map, options_.lanes.fit);
   if (!control_points) {
     ++counters_.lane_observations_unused;
     return;

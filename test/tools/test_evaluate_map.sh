@@ -23,7 +23,9 @@ tool() {
   echo "$path"
 }
 evaluate_map_bin=$(tool evaluate_map)
-plot_map_bin=$(tool plot_map.py)
+# Python tools run from the package's scripts/ folder (rosrun finds them there).
+plot_map_bin="$(rospack find ipm_road_mapper)/scripts/plot_map.py"
+[ -x "$plot_map_bin" ] || fail "$plot_map_bin is missing or not executable"
 evaluate_map() { "$evaluate_map_bin" "$@"; }
 plot_map() { "$plot_map_bin" "$@"; }
 

@@ -32,10 +32,14 @@ ExtractionOptions LoadExtractionOptions(OptionsReader reader);
 // otherwise the reason (e.g. "mask is 640x480, camera is 1280x720").
 std::string ValidateMask(const cv::Mat& mask, int expected_width, int expected_height);
 
-// Extracts every instance of `mask` (which must pass ValidateMask). Markings: outer contour
-// -> IPM of the contour pixels -> minimum-area rectangle on the ground -> canonical corners,
-// projected back for the pixel measurements. Lanes: centerline pixel per sampled row (mean
-// column of the instance's pixels in that row) -> IPM point + uncertainty score.
+// Extracts every instance of `mask` (which must pass ValidateMask; an unusable mask gives
+// nothing). One scan groups the pixels by value; unknown classes, tiny instances and markings
+// within border_margin_px of the border are dropped from its statistics; of the rest the
+// max_instances_per_frame largest are processed. Markings: sub-pixel outline of the largest
+// 8-connected piece -> IPM (any outline point failing: dropped_range) -> minimum-area
+// rectangle on the ground -> canonical corners, projected back for the pixel measurements.
+// Lanes: every lane_row_step rows from the bottom, the center column of each run of the
+// instance's pixels in that row -> IPM point + uncertainty score. Results sorted by value.
 FrameObservations ExtractObservations(const cv::Mat& mask, const ClassTable& classes,
                                       const Ipm& ipm, const IpmErrorModel& error_model,
                                       const ExtractionOptions& options);

@@ -91,7 +91,8 @@ class Mapper {
   void AddMarkings(const FrameObservations& observations, const FrameRecord& frame);
   void AddLanes(const FrameObservations& observations, const FrameRecord& frame);
   void StartLane(int class_id, const LaneMeasurement& measurement,
-                 const std::vector<Eigen::Vector3d>& selected_map, const FrameRecord& frame);
+                 const std::vector<Eigen::Vector3d>& selected_map,
+                 const std::vector<Eigen::Vector3d>& usable_map, const FrameRecord& frame);
   // Selected pixels of every observation of the lane, IPMed now and put in the map.
   std::vector<Eigen::Vector3d> SelectedPointsMap(const LaneElement& lane) const;
   void RefitLane(LaneElement* lane) const;

@@ -1,0 +1,140 @@
+// Bag input helpers: topic checks, the extrinsic from a chain of /tf_static transforms, and
+// camera_info <-> mask pairing (exact by ros::Time, approximate within half a period), on
+// small bags written here.
+#include <gtest/gtest.h>
+#include <rosbag/bag.h>
+#include <stdlib.h>
+#include <tf2_msgs/TFMessage.h>
+#include <unistd.h>
+
+#include <cstdio>
+#include <string>
+
+#include "ipm_road_mapper/ros/bag_input.h"
+#include "ipm_road_mapper/ros/msg_conversion.h"
+
+namespace ipm_road_mapper {
+namespace {
+
+constexpr double kT0 = 1700000000.0;  // epoch stamps: doubles are too coarse for "exact"
+
+Eigen::Isometry3d MakePose(double x, double y, double z, double roll, double pitch, double yaw) {
+  Eigen::Isometry3d T = Eigen::Isometry3d::Identity();
+  T.linear() = RotationFromRpy(roll, pitch, yaw);
+  T.translation() = Eigen::Vector3d(x, y, z);
+  return T;
+}
+
+class BagInputTest : public ::testing::Test {
+ protected:
+  void SetUp() override {
+    ros::Time::init();
+    char pattern[] = "/tmp/irm_bag_input_XXXXXX.bag";
+    const int fd = mkstemps(pattern, 4);
+    ASSERT_GE(fd, 0);
+    close(fd);
+    path_ = pattern;
+    rosbag::Bag bag(path_, rosbag::bagmode::Write);
+    // base_link -> camera_link -> camera_optical, in two messages.
+    tf2_msgs::TFMessage first, second;
+    first.transforms.push_back(
+        IsometryToTransformStamped(T_base_link_, ros::Time(kT0), "base_link", "camera_link"));
+    second.transforms.push_back(IsometryToTransformStamped(T_link_optical_, ros::Time(kT0),
+                                                           "camera_link", "camera_optical"));
+    bag.write("/tf_static", ros::Time(kT0), first);
+    bag.write("/tf_static", ros::Time(kT0), second);
+    CameraIntrinsics intrinsics;
+    intrinsics.width = 640;
+    intrinsics.height = 480;
+    intrinsics.fx = intrinsics.fy = 500.0;
+    intrinsics.cx = 320.0;
+    intrinsics.cy = 240.0;
+    for (int k = 0; k < 10; ++k) {
+      sensor_msgs::CameraInfo info = IntrinsicsToCameraInfo(intrinsics);
+      info.header.stamp = ros::Time(kT0) + ros::Duration(0.1 * k);
+      if (k == 7) info.distortion_model = "equidistant";
+      bag.write("/camera/camera_info", info.header.stamp, info);
+    }
+    bag.close();
+    bag_.open(path_, rosbag::bagmode::Read);
+  }
+  void TearDown() override {
+    bag_.close();
+    std::remove(path_.c_str());
+  }
+
+  const Eigen::Isometry3d T_base_link_ = MakePose(1.2, 0.1, 1.4, 0.0, 0.05, 0.0);
+  const Eigen::Isometry3d T_link_optical_ = MakePose(0.0, 0.0, 0.0, -M_PI / 2, 0.0, -M_PI / 2);
+  std::string path_;
+  rosbag::Bag bag_;
+};
+
+TEST_F(BagInputTest, TopicChecks) {
+  const auto types = BagTopicTypes(bag_);
+  EXPECT_EQ(types.at("/camera/camera_info"), "sensor_msgs/CameraInfo");
+  EXPECT_EQ(CheckBagTopics(bag_, {{"/camera/camera_info", "sensor_msgs/CameraInfo"}}), "");
+  const std::string missing = CheckBagTopics(bag_, {{"/odom", "nav_msgs/Odometry"}});
+  EXPECT_NE(missing.find("topic /odom (nav_msgs/Odometry) is not in the bag"), std::string::npos)
+      << missing;
+  EXPECT_NE(missing.find("/tf_static"), std::string::npos) << "lists the bag's topics";
+  const std::string wrong = CheckBagTopics(bag_, {{"/camera/camera_info", "sensor_msgs/Image"}});
+  EXPECT_NE(wrong.find("has type sensor_msgs/CameraInfo"), std::string::npos) << wrong;
+}
+
+TEST_F(BagInputTest, StaticTransformChainIsComposed) {
+  Eigen::Isometry3d T_base_cam;
+  ASSERT_EQ(LookupStaticTransform(bag_, "base_link", "camera_optical", &T_base_cam), "");
+  EXPECT_TRUE(T_base_cam.isApprox(T_base_link_ * T_link_optical_, 1e-9));
+  // The direction matters: the inverse lookup gives the inverse transform.
+  Eigen::Isometry3d T_cam_base;
+  ASSERT_EQ(LookupStaticTransform(bag_, "camera_optical", "base_link", &T_cam_base), "");
+  EXPECT_TRUE(T_cam_base.isApprox(T_base_cam.inverse(), 1e-9));
+}
+
+TEST_F(BagInputTest, MissingStaticTransform) {
+  Eigen::Isometry3d T;
+  const std::string error = LookupStaticTransform(bag_, "base_link", "lidar", &T);
+  EXPECT_NE(error.find("no transform base_link -> lidar"), std::string::npos) << error;
+}
+
+TEST_F(BagInputTest, ExactSyncComparesRosTime) {
+  const CameraInfoTable table = CameraInfoTable::Read(bag_, "/camera/camera_info");
+  ASSERT_EQ(table.size(), 10u);
+  EXPECT_NEAR(table.approximate_tolerance_s(), 0.05, 1e-6);
+  CameraIntrinsics intrinsics;
+  const ros::Time stamp3 = ros::Time(kT0) + ros::Duration(0.3);
+  ASSERT_EQ(table.Match(stamp3, /*exact=*/true, &intrinsics), "");
+  EXPECT_EQ(intrinsics.width, 640);
+  // One nanosecond off is not exact.
+  const std::string off = table.Match(stamp3 + ros::Duration(0, 1), true, &intrinsics);
+  EXPECT_EQ(off.rfind("no_camera_info: ", 0), 0u) << off;
+}
+
+TEST_F(BagInputTest, ApproximateSyncWithinHalfAPeriod) {
+  const CameraInfoTable table = CameraInfoTable::Read(bag_, "/camera/camera_info");
+  CameraIntrinsics intrinsics;
+  const ros::Time stamp3 = ros::Time(kT0) + ros::Duration(0.3);
+  EXPECT_EQ(table.Match(stamp3 + ros::Duration(0.04), false, &intrinsics), "");
+  EXPECT_EQ(table.Match(stamp3 - ros::Duration(0.04), false, &intrinsics), "");
+  // Beyond the last camera_info by more than half a period.
+  const std::string late = table.Match(ros::Time(kT0 + 1.5), false, &intrinsics);
+  EXPECT_EQ(late.rfind("no_camera_info: ", 0), 0u) << late;
+}
+
+TEST_F(BagInputTest, UnsupportedCameraInfoIsReportedForItsFrame) {
+  const CameraInfoTable table = CameraInfoTable::Read(bag_, "/camera/camera_info");
+  CameraIntrinsics intrinsics;
+  const std::string error = table.Match(ros::Time(kT0) + ros::Duration(0.7), true, &intrinsics);
+  EXPECT_EQ(error.rfind("bad_camera_info: ", 0), 0u) << error;
+  EXPECT_NE(error.find("equidistant"), std::string::npos) << error;
+}
+
+TEST(CameraInfoTableTest, EmptyTopic) {
+  CameraInfoTable table;
+  CameraIntrinsics intrinsics;
+  EXPECT_EQ(table.Match(ros::Time(1.0), true, &intrinsics),
+            "no_camera_info: no camera_info in the bag");
+}
+
+}  // namespace
+}  // namespace ipm_road_mapper

@@ -1,0 +1,234 @@
+#!/usr/bin/env bash
+# End-to-end test of `rosrun ipm_road_mapper map_from_bag` on a small drive generated here
+# (test/tools/make_test_bag.py): the outputs exist and parse, the marking lands where the
+# ground truth put it, the GeoJSON is accepted by a standard reader (python3-geojson and
+# python3-shapely when installed; the structure is always checked by hand too), the
+# extrinsic comes from /tf_static or the config, approximate sync pairs shifted
+# camera_infos, a bag loop is counted, and every kind of bad input exits 2 with one line.
+# Run by ctest in the devel space's environment (IRM_SOURCE_DIR = the repository).
+set -eo pipefail
+export PATH="/usr/bin:/bin:$PATH"
+repo="${IRM_SOURCE_DIR:-$(cd "$(dirname "${BASH_SOURCE[0]}")/../.." && pwd)}"
+work="$(mktemp -d /tmp/irm_map_from_bag_XXXXXX)"
+trap 'rm -rf "$work"' EXIT
+export ROS_HOME="$work/ros_home"
+failures=0
+
+fail() { echo "FAIL: $*"; failures=$((failures + 1)); }
+pass() { echo "ok: $*"; }
+
+make_bag() { /usr/bin/python3 "$repo/test/tools/make_test_bag.py" "$@"; }
+run_mapper() { rosrun ipm_road_mapper map_from_bag "$@"; }
+
+# A config overlaying the package's config/mapper.yaml (`base:`) with the given YAML lines;
+# the back end is off so these runs check the runner and the front end only (run 1 runs the
+# full default config).
+overlay() {
+  local out="$work/$1"; shift
+  { echo "base: $repo/config/mapper.yaml"; echo "backend: {enabled: false}"; printf '%s\n' "$@"; } >"$out"
+  echo "$out"
+}
+
+# Expects exit status 2 and exactly one line on stderr mentioning $2.
+expect_input_error() {
+  local name="$1" pattern="$2"; shift 2
+  local rc=0
+  run_mapper "$@" >"$work/stdout" 2>"$work/stderr" || rc=$?
+  local lines
+  lines=$(wc -l <"$work/stderr")
+  if [ "$rc" -ne 2 ]; then
+    fail "$name: exit $rc, expected 2 ($(cat "$work/stderr"))"
+  elif [ "$lines" -ne 1 ]; then
+    fail "$name: $lines stderr lines, expected one:"; cat "$work/stderr"
+  elif ! grep -q -- "$pattern" "$work/stderr"; then
+    fail "$name: error does not mention '$pattern': $(cat "$work/stderr")"
+  else
+    pass "$name -> exit 2: $(cat "$work/stderr")"
+  fi
+}
+
+make_bag "$work/drive.bag"
+make_bag "$work/no_tf.bag" --no-tf
+make_bag "$work/shifted.bag" --camera-info-offset 0.002
+make_bag "$work/loop.bag" --loop
+
+# map.json has the arrow where the ground truth put it; one TUM pose per frame.
+check_outputs() {
+  /usr/bin/python3 - "$1" <<'EOF'
+import json, sys
+out = sys.argv[1]
+m = json.load(open(out + "/map.json"))
+assert len(m["markings"]) >= 1, "no marking mapped"
+# Ground truth: the arrow at x 18..21, y -0.6..0.6 (center 19.5, 0).
+best = min(m["markings"], key=lambda k: (sum(c[0] for c in k["corners"]) / 4 - 19.5) ** 2)
+cx = sum(c[0] for c in best["corners"]) / 4
+cy = sum(c[1] for c in best["corners"]) / 4
+assert abs(cx - 19.5) < 0.5 and abs(cy) < 0.3, f"marking center ({cx:.2f}, {cy:.2f})"
+rows = [l.split() for l in open(out + "/trajectory_tum.txt") if not l.startswith("#")]
+assert len(rows) == 25 and all(len(r) == 8 for r in rows), f"{len(rows)} TUM rows"
+print(f"ok: map.json: {len(m['markings'])} markings, {len(m['lanes'])} lanes; "
+      f"arrow center ({cx:.2f}, {cy:.2f}); 25 TUM poses")
+EOF
+}
+
+# The GeoJSON: hand-checked structure plus any standard reader that is installed.
+check_geojson() {
+  /usr/bin/python3 - "$1" "$2" <<'EOF'
+import json, sys
+path, expected_system = sys.argv[1], sys.argv[2]
+text = open(path).read()
+g = json.loads(text)
+assert g["type"] == "FeatureCollection" and "crs" not in g
+assert g["coordinate_system"] == expected_system, g["coordinate_system"]
+kinds = {}
+for f in g["features"]:
+    assert f["type"] == "Feature" and isinstance(f["properties"], dict)
+    kinds[f["properties"]["kind"]] = kinds.get(f["properties"]["kind"], 0) + 1
+    geometry = f["geometry"]
+    if geometry is None:
+        continue
+    if geometry["type"] == "Polygon":
+        ring = geometry["coordinates"][0]
+        assert len(ring) == 5 and ring[0] == ring[-1], "ring not closed"
+        area2 = sum(a[0] * b[1] - b[0] * a[1] for a, b in zip(ring, ring[1:]))
+        assert area2 > 0, "exterior ring is not counter-clockwise"
+    else:
+        assert geometry["type"] == "LineString" and len(geometry["coordinates"]) >= 2
+    for position in (geometry["coordinates"][0] if geometry["type"] == "Polygon"
+                     else geometry["coordinates"]):
+        assert len(position) == 3 and all(isinstance(v, (int, float)) for v in position)
+assert kinds.get("marking", 0) >= 1, kinds
+readers = []
+try:
+    import geojson  # python3-geojson: RFC 7946 validation
+    obj = geojson.loads(text)
+    assert obj.is_valid, obj.errors()
+    readers.append("geojson " + geojson.__version__)
+except ImportError:
+    pass
+try:
+    from shapely.geometry import shape  # python3-shapely: geometry validity, orientation
+    for f in g["features"]:
+        if f["geometry"] is not None:
+            s = shape(f["geometry"])
+            assert s.is_valid, f"invalid {s.geom_type}"
+            if s.geom_type == "Polygon":
+                assert s.exterior.is_ccw
+    readers.append("shapely")
+except ImportError:
+    pass
+print(f"ok: {path}: {kinds}; readers: {', '.join(readers) or 'none installed (hand checks only)'}")
+EOF
+}
+
+# 1. The normal run: the default (full) config and classes, found through the package.
+if run_mapper --bag "$work/drive.bag" --out "$work/out" >"$work/summary.log" 2>"$work/progress.log"; then
+  pass "map_from_bag on drive.bag (default config)"
+  cat "$work/summary.log"
+  for file in map.json map.geojson trajectory_tum.txt summary.txt; do
+    [ -s "$work/out/$file" ] || fail "$file missing or empty"
+  done
+  grep -q "^frames read: 25$" "$work/out/summary.txt" || fail "summary: frames read is not 25"
+  grep -q "^frames used: 25$" "$work/out/summary.txt" || fail "summary: not all 25 frames used"
+  grep -q "frames/s" "$work/progress.log" || fail "no progress line on stderr"
+  check_outputs "$work/out" || fail "output checks of the default run (above)"
+  default_run=ok
+else
+  fail "map_from_bag on drive.bag (default config) exited $?:"; tail -5 "$work/progress.log"
+fi
+
+if [ "$default_run" = ok ]; then
+  check_geojson "$work/out/map.geojson" local_metric_enu_m || fail "map.geojson (default run) checks"
+fi
+
+# The plain-IPM ablation (a `base:` config) maps the lane too: a LineString in the GeoJSON.
+if run_mapper --bag "$work/drive.bag" --config "$repo/config/ablations/ipm.yaml" --out "$work/ipm" \
+    >/dev/null 2>&1; then
+  check_geojson "$work/ipm/map.geojson" local_metric_enu_m || fail "map.geojson (ipm) checks"
+  /usr/bin/python3 - "$work/ipm" <<'EOF' || fail "lane of the ipm run"
+import json, sys
+m = json.load(open(sys.argv[1] + "/map.json"))
+g = json.load(open(sys.argv[1] + "/map.geojson"))
+assert len(m["lanes"]) >= 1, "no lane mapped"
+lines = [f for f in g["features"] if f["properties"]["kind"] == "lane"]
+assert lines and lines[0]["geometry"]["type"] == "LineString"
+ys = [p[1] for p in lines[0]["geometry"]["coordinates"]]
+assert all(abs(y - 1.675) < 0.3 for y in ys), (min(ys), max(ys))
+print(f"ok: ipm config: {len(m['lanes'])} lane(s), LineString of {len(ys)} points near y = 1.675")
+EOF
+else
+  fail "map_from_bag with config/ablations/ipm.yaml"
+fi
+
+# 2. A geo origin: positions become lon/lat near it.
+geo_config=$(overlay geo.yaml "geo_origin: {latitude_deg: 48.0, longitude_deg: 11.0, altitude_m: 500.0}")
+if run_mapper --bag "$work/drive.bag" --config "$geo_config" --out "$work/geo" >/dev/null 2>&1; then
+  check_geojson "$work/geo/map.geojson" wgs84 || fail "map.geojson (wgs84) checks"
+  /usr/bin/python3 - "$work/geo/map.geojson" <<'EOF' || fail "lon/lat of the arrow"
+import json, sys
+g = json.load(open(sys.argv[1]))
+lons = [p[0] for f in g["features"] if f["geometry"] and f["geometry"]["type"] == "Polygon"
+        for p in f["geometry"]["coordinates"][0]]
+lats = [p[1] for f in g["features"] if f["geometry"] and f["geometry"]["type"] == "Polygon"
+        for p in f["geometry"]["coordinates"][0]]
+# 18..21 m east of the origin at 48 deg N: 0.00024..0.00029 deg of longitude.
+assert 11.0002 < min(lons) and max(lons) < 11.0010, (min(lons), max(lons))
+assert abs(sum(lats) / len(lats) - 48.0) < 1e-4
+print(f"ok: wgs84 marking longitudes {min(lons):.6f}..{max(lons):.6f}")
+EOF
+else
+  fail "map_from_bag with geo_origin"
+fi
+
+# 3. The extrinsic from the config when the bag has no /tf_static.
+extrinsic_config=$(overlay extrinsic.yaml \
+  "input: {extrinsic: {xyz: [1.0, 0.0, 1.5], rpy_deg: [-95.0, 0.0, -90.0]}}")
+if run_mapper --bag "$work/no_tf.bag" --config "$extrinsic_config" --out "$work/cfg" >/dev/null 2>&1 &&
+   grep -q "^extrinsic: config input.extrinsic" "$work/cfg/summary.txt" &&
+   grep -q "^frames used: 25$" "$work/cfg/summary.txt" && check_outputs "$work/cfg"; then
+  pass "extrinsic from the config"
+else
+  fail "extrinsic from the config"
+fi
+
+# 4. Sync: camera_info 2 ms off the masks. Exact pairs none; approximate pairs all.
+exact_config=$(overlay exact.yaml "input: {sync: exact}")
+run_mapper --bag "$work/shifted.bag" --config "$exact_config" --out "$work/exact" >/dev/null 2>&1 || fail "exact sync run"
+grep -q "^  no_camera_info: 25$" "$work/exact/summary.txt" && pass "exact sync skips shifted camera_info" \
+  || fail "exact sync: $(grep -A3 skipped "$work/exact/summary.txt")"
+approx_config=$(overlay approx.yaml "input: {sync: approximate}")
+run_mapper --bag "$work/shifted.bag" --config "$approx_config" --out "$work/approx" >/dev/null 2>&1 \
+  || fail "approximate sync run"
+grep -q "^frames used: 25$" "$work/approx/summary.txt" && check_outputs "$work/approx" &&
+  pass "approximate sync pairs them" \
+  || fail "approximate sync: $(grep frames "$work/approx/summary.txt")"
+
+# 5. A bag loop: counted as a time jump; every frame is accounted for.
+run_mapper --bag "$work/loop.bag" --config "$exact_config" --out "$work/loop" >/dev/null 2>&1 || fail "loop run"
+if grep -q "time jumps: 1$" "$work/loop/summary.txt" && grep -q "^frames read: 50$" "$work/loop/summary.txt" &&
+   grep -q "^frames used: 25$" "$work/loop/summary.txt" && grep -q "^frames skipped: 25$" "$work/loop/summary.txt"; then
+  pass "bag loop: 1 time jump, 25 used + 25 skipped"
+else
+  fail "bag loop summary:"; cat "$work/loop/summary.txt"
+fi
+
+# 6. Bad input: one clear line, exit 2.
+expect_input_error "missing bag" "no such bag" --bag "$work/nope.bag" --out "$work/x"
+expect_input_error "no --out" "usage" --bag "$work/drive.bag"
+expect_input_error "unknown flag" "unknown argument" --bag "$work/drive.bag" --out "$work/x" --fast
+bad_key=$(overlay bad_key.yaml "bogus_key: 1")
+expect_input_error "bad config key" "bogus_key: unknown key" --bag "$work/drive.bag" --config "$bad_key" --out "$work/x"
+bad_value=$(overlay bad_value.yaml "input: {sync: sometimes}")
+expect_input_error "bad config value" "input.sync" --bag "$work/drive.bag" --config "$bad_value" --out "$work/x"
+missing_topic=$(overlay missing_topic.yaml "input: {mask_topic: /nope}")
+expect_input_error "missing topic" "/nope" --bag "$work/drive.bag" --config "$missing_topic" --out "$work/x"
+expect_input_error "no extrinsic" "no extrinsic" --bag "$work/no_tf.bag" --out "$work/x"
+echo "not a bag" >"$work/garbage.bag"
+expect_input_error "not a bag" "garbage.bag" --bag "$work/garbage.bag" --out "$work/x"
+expect_input_error "missing classes" "nope.yaml" --bag "$work/drive.bag" --classes "$work/nope.yaml" --out "$work/x"
+
+if [ "$failures" -ne 0 ]; then
+  echo "$failures check(s) failed"
+  exit 1
+fi
+echo "all map_from_bag checks passed"
