@@ -19,8 +19,8 @@ constexpr double kGaussWeights[5] = {0.5688888888888889, 0.4786286704993665, 0.4
                                      0.2369268850561891, 0.2369268850561891};
 constexpr int kQuadratureIntervals = 2;
 
-// Golden-section search iterations: shrinks a bracket of width <= 0.25 below 1e-9.
-constexpr int kGoldenIterations = 40;
+// Iterations of the safeguarded Newton search of a closest point (it converges in 3-5).
+constexpr int kNewtonIterations = 30;
 
 }  // namespace
 
@@ -34,8 +34,31 @@ CatmullRomSpline::CatmullRomSpline(std::vector<Eigen::Vector3d> control_points)
     if (!c.allFinite()) throw std::invalid_argument("CatmullRomSpline: non-finite control point");
   }
   cumulative_length_.assign(NumSegments() + 1, 0.0);
+  samples_.resize(NumSegments());
   for (int i = 0; i < NumSegments(); ++i) {
-    cumulative_length_[i + 1] = cumulative_length_[i] + SegmentArcLength(i, 1.0);
+    const double length = SegmentArcLength(i, 1.0);
+    cumulative_length_[i + 1] = cumulative_length_[i] + length;
+    // A grid of step <= ~0.25 m of arc (at least 8 steps) for the coarse closest-point pass.
+    SegmentSamples& samples = samples_[i];
+    const int steps = std::clamp(static_cast<int>(std::ceil(length / 0.25)), 8, 256);
+    samples.step_u = 1.0 / steps;
+    samples.points.resize(steps + 1);
+    const auto& c = control_points_;
+    for (int k = 0; k <= steps; ++k) {
+      samples.points[k] = EvaluateSegment<double>(c[i], c[i + 1], c[i + 2], c[i + 3],
+                                                  static_cast<double>(k) / steps);
+      samples.center += samples.points[k];
+      if (k > 0) {
+        samples.step_m =
+            std::max(samples.step_m, (samples.points[k] - samples.points[k - 1]).norm());
+      }
+    }
+    samples.center /= steps + 1;
+    for (const Eigen::Vector3d& p : samples.points) {
+      samples.radius = std::max(samples.radius, (p - samples.center).norm());
+    }
+    // Between two samples the curve strays from them by less than the chord between them.
+    samples.radius += samples.step_m;
   }
 }
 
@@ -133,6 +156,42 @@ std::vector<Eigen::Vector3d> CatmullRomSpline::SampleByArcLength(double spacing_
   return samples;
 }
 
+double CatmullRomSpline::MinimizeInBracket(int segment, const Eigen::Vector3d& query, double u,
+                                           double* a, double* b) const {
+  // Minimizes g(u) = |p(u) - q|^2 / 2 on [a, b]: g' = (p - q).p', g'' = |p'|^2 + (p - q).p''.
+  // A Newton step is taken when g'' > 0 and it stays inside the bracket, which shrinks by the
+  // sign of g' at every iterate; otherwise the bracket is bisected.
+  const auto& c = control_points_;
+  const Eigen::Vector3d a2 =
+      2.0 * c[segment] - 5.0 * c[segment + 1] + 4.0 * c[segment + 2] - c[segment + 3];
+  const Eigen::Vector3d a3 = 3.0 * (c[segment + 1] - c[segment + 2]) + c[segment + 3] - c[segment];
+  for (int iteration = 0; iteration < kNewtonIterations; ++iteration) {
+    const Eigen::Vector3d d =
+        EvaluateSegment<double>(c[segment], c[segment + 1], c[segment + 2], c[segment + 3], u) -
+        query;
+    const Eigen::Vector3d dp =
+        SegmentDerivative<double>(c[segment], c[segment + 1], c[segment + 2], c[segment + 3], u);
+    const Eigen::Vector3d ddp = a2 + 3.0 * a3 * u;  // 0.5 * (2 a2 + 6 a3 u)
+    const double g1 = d.dot(dp);
+    const double g2 = dp.squaredNorm() + d.dot(ddp);
+    if (g1 > 0.0) {
+      *b = u;
+    } else if (g1 < 0.0) {
+      *a = u;
+    } else {
+      break;
+    }
+    double next = g2 > 0.0 ? u - g1 / g2 : 0.5 * (*a + *b);
+    if (!(next > *a && next < *b)) next = 0.5 * (*a + *b);
+    if (std::abs(next - u) < 1e-13 || *b - *a < 1e-13) {
+      u = next;
+      break;
+    }
+    u = next;
+  }
+  return u;
+}
+
 double CatmullRomSpline::SquaredDistance(int segment, double u,
                                          const Eigen::Vector3d& query) const {
   const auto& c = control_points_;
@@ -142,63 +201,57 @@ double CatmullRomSpline::SquaredDistance(int segment, double u,
 }
 
 CatmullRomSpline::ClosestPoint CatmullRomSpline::FindClosest(const Eigen::Vector3d& query) const {
-  // 1) Coarse: per segment, sample u on a grid of step <= ~0.25 m of arc (at least 8 steps) and
-  //    keep the best sample. 2) A segment can only beat the best coarse sample d* if its own
-  //    best sample d_i satisfies d_i - step_i <= d* (any curve point lies within one step of a
-  //    sample), so only those are refined. 3) Refine by golden-section search on the bracket
-  //    of the two neighboring samples; the bracket ends are candidates too, which makes
-  //    queries beyond the ends land exactly on them.
+  // 1) Coarse: per segment, the best of its precomputed samples (step <= ~0.25 m of arc).
+  //    Segments are visited by increasing lower bound |query - center| - radius of their
+  //    bounding sphere and the visit stops once that bound exceeds the best sample so far
+  //    (no point of such a segment can be closer). 2) A visited segment can only beat the
+  //    best coarse sample d* if its own best sample d_i satisfies d_i - step_i <= d* (any
+  //    curve point lies within one step of a sample), so only those are refined. 3) Refine by
+  //    golden-section search on the bracket of the two neighboring samples; the bracket ends
+  //    are candidates too, which makes queries beyond the ends land exactly on them.
   struct Coarse {
+    int segment;
     double distance;
     double u;
-    double step_u;
-    double step_m;
   };
-  std::vector<Coarse> coarse(NumSegments());
+  const int n = NumSegments();
+  std::vector<std::pair<double, int>> order(n);
+  for (int i = 0; i < n; ++i) {
+    order[i] = {(query - samples_[i].center).norm() - samples_[i].radius, i};
+  }
+  std::sort(order.begin(), order.end());
+  std::vector<Coarse> coarse;
   double best_coarse = std::numeric_limits<double>::infinity();
-  for (int i = 0; i < NumSegments(); ++i) {
-    const double length = cumulative_length_[i + 1] - cumulative_length_[i];
-    const int steps = std::clamp(static_cast<int>(std::ceil(length / 0.25)), 8, 256);
-    Coarse& best = coarse[i];
-    best = {std::numeric_limits<double>::infinity(), 0.0, 1.0 / steps, 0.0};
-    Eigen::Vector3d previous = Evaluate(i);
-    for (int k = 0; k <= steps; ++k) {
-      const double u = static_cast<double>(k) / steps;
-      const Eigen::Vector3d p = Evaluate(i + u);
-      best.step_m = std::max(best.step_m, (p - previous).norm());
-      previous = p;
-      const double d = (p - query).norm();
+  for (const auto& [lower_bound, i] : order) {
+    if (lower_bound > best_coarse) break;
+    const SegmentSamples& samples = samples_[i];
+    Coarse best{i, std::numeric_limits<double>::infinity(), 0.0};
+    for (std::size_t k = 0; k < samples.points.size(); ++k) {
+      const double d = (samples.points[k] - query).norm();
       if (d < best.distance) {
         best.distance = d;
-        best.u = u;
+        best.u = static_cast<double>(k) * samples.step_u;
       }
     }
     best_coarse = std::min(best_coarse, best.distance);
+    coarse.push_back(best);
   }
+  // Segment order as in a plain scan, so that ties resolve to the lower segment.
+  std::sort(coarse.begin(), coarse.end(),
+            [](const Coarse& a, const Coarse& b) { return a.segment < b.segment; });
 
   ClosestPoint result;
   double best_squared = std::numeric_limits<double>::infinity();
-  const double golden = 0.5 * (std::sqrt(5.0) - 1.0);
-  for (int i = 0; i < NumSegments(); ++i) {
+  for (const Coarse& candidate : coarse) {
+    const int i = candidate.segment;
+    const SegmentSamples& samples = samples_[i];
     // 1.5 x the chord between samples bounds the arc between them for gentle curves.
-    if (coarse[i].distance - 1.5 * coarse[i].step_m > best_coarse) continue;
-    double a = std::max(0.0, coarse[i].u - coarse[i].step_u);
-    double b = std::min(1.0, coarse[i].u + coarse[i].step_u);
+    if (candidate.distance - 1.5 * samples.step_m > best_coarse) continue;
+    double a = std::max(0.0, candidate.u - samples.step_u);
+    double b = std::min(1.0, candidate.u + samples.step_u);
     const double bracket_a = a, bracket_b = b;
-    double x1 = b - golden * (b - a), x2 = a + golden * (b - a);
-    double f1 = SquaredDistance(i, x1, query), f2 = SquaredDistance(i, x2, query);
-    for (int iteration = 0; iteration < kGoldenIterations; ++iteration) {
-      if (f1 <= f2) {
-        b = x2, x2 = x1, f2 = f1;
-        x1 = b - golden * (b - a);
-        f1 = SquaredDistance(i, x1, query);
-      } else {
-        a = x1, x1 = x2, f1 = f2;
-        x2 = a + golden * (b - a);
-        f2 = SquaredDistance(i, x2, query);
-      }
-    }
-    const double candidates[3] = {bracket_a, 0.5 * (a + b), bracket_b};
+    const double u_min = MinimizeInBracket(i, query, candidate.u, &a, &b);
+    const double candidates[3] = {bracket_a, u_min, bracket_b};
     for (double u : candidates) {
       const double f = SquaredDistance(i, u, query);
       if (f < best_squared) {

@@ -95,12 +95,26 @@ class CatmullRomSpline {
   std::vector<Eigen::Vector3d> SampleByArcLength(double spacing_m) const;
 
   // Global closest curve point to `query` over all segments. Queries beyond an end get that
-  // end (s = 0 or s = NumSegments()).
+  // end (s = 0 or s = NumSegments()). Segments whose bounding sphere is farther than the best
+  // sample found so far are skipped, so a query costs about two segments' work on a long lane.
   ClosestPoint FindClosest(const Eigen::Vector3d& query) const;
 
  private:
+  // A segment sampled on a regular u grid (built once, for closest-point queries).
+  struct SegmentSamples {
+    std::vector<Eigen::Vector3d> points;  // at u = k / (points.size() - 1)
+    double step_u = 0.0;
+    double step_m = 0.0;                  // longest chord between consecutive samples
+    Eigen::Vector3d center = Eigen::Vector3d::Zero();
+    double radius = 0.0;                  // every curve point is within this of center
+  };
+
   // Arc length within `segment` from u = 0 to u.
   double SegmentArcLength(int segment, double u) const;
+  // Local minimum of the distance to `query` over u in [*a, *b] of `segment`, started at u
+  // (the bracket shrinks around it).
+  double MinimizeInBracket(int segment, const Eigen::Vector3d& query, double u, double* a,
+                           double* b) const;
   // Squared distance from `query` to the point of `segment` at u.
   double SquaredDistance(int segment, double u, const Eigen::Vector3d& query) const;
 
@@ -108,6 +122,7 @@ class CatmullRomSpline {
   // cumulative_length_[i] = arc length from the start to the beginning of segment i;
   // cumulative_length_[NumSegments()] = Length().
   std::vector<double> cumulative_length_;
+  std::vector<SegmentSamples> samples_;
 };
 
 }  // namespace ipm_road_mapper
