@@ -11,8 +11,12 @@ namespace ipm_road_mapper {
 
 AssociationOptions LoadAssociationOptions(OptionsReader reader) {
   AssociationOptions o;
-  reader.Read<double>("marking_gate_m", &o.marking_gate_m, CheckPositive);
+  reader.Read<double>("marking_gate_sigmas", &o.marking_gate_sigmas, CheckPositive);
+  reader.Read<double>("marking_position_sigma_m", &o.marking_position_sigma_m, CheckPositive);
+  reader.Read<double>("lane_max_point_score_m2", &o.lane_max_point_score_m2, CheckPositive);
   reader.Read<double>("lane_gate_m", &o.lane_gate_m, CheckPositive);
+  reader.Read<double>("lane_gate_sigmas", &o.lane_gate_sigmas, CheckPositive);
+  reader.Read<double>("lane_position_sigma_m", &o.lane_position_sigma_m, CheckPositive);
   reader.Read<double>("lane_min_direction_cos", &o.lane_min_direction_cos, CheckProbability);
   reader.Read<double>("lane_max_end_gap_m", &o.lane_max_end_gap_m, CheckNonNegative);
   reader.Read<double>("lane_min_support", &o.lane_min_support, CheckProbability);
@@ -59,17 +63,26 @@ Eigen::Vector3d Mean(const std::array<Eigen::Vector3d, 4>& corners) {
 
 }  // namespace
 
+double MarkingAssociationCost(const MarkingElement& element, const MarkingCandidate& candidate,
+                              const AssociationOptions& options) {
+  // Compare in x-y: the mapped z of a marking is refined later, the gate is planar.
+  const Eigen::Vector2d d = (element.Center() - Mean(candidate.corners_map)).head<2>();
+  const double floor = options.marking_position_sigma_m * options.marking_position_sigma_m;
+  const Eigen::Matrix2d S =
+      candidate.center_cov_map + element.center_cov_map + floor * Eigen::Matrix2d::Identity();
+  return d.dot(S.ldlt().solve(d));
+}
+
 std::vector<int> AssociateMarkings(const std::vector<MarkingElement>& elements,
                                    const std::vector<MarkingCandidate>& candidates,
                                    const AssociationOptions& options) {
   std::vector<std::tuple<double, int, int>> pairs;
+  const double gate = options.marking_gate_sigmas * options.marking_gate_sigmas;
   for (int c = 0; c < static_cast<int>(candidates.size()); ++c) {
-    const Eigen::Vector3d center = Mean(candidates[c].corners_map);
     for (int e = 0; e < static_cast<int>(elements.size()); ++e) {
       if (elements[e].class_id != candidates[c].class_id) continue;
-      // Compare in x-y: the mapped z of a marking is refined later, the gate is planar.
-      const double distance = (elements[e].Center() - center).head<2>().norm();
-      if (distance <= options.marking_gate_m) pairs.emplace_back(distance, c, e);
+      const double cost = MarkingAssociationCost(elements[e], candidates[c], options);
+      if (cost <= gate) pairs.emplace_back(cost, c, e);
     }
   }
   return AssignGreedy(std::move(pairs), static_cast<int>(candidates.size()),
@@ -82,20 +95,29 @@ double LaneAssociationCost(const LaneElement& lane, const LaneCandidate& candida
       candidate.points_map.size() < 2) {
     return -1.0;
   }
+  std::vector<Eigen::Vector3d> points;
+  std::vector<Eigen::Matrix2d> covs;
+  for (std::size_t i = 0; i < candidate.points_map.size(); ++i) {
+    if (!candidate.usable.empty() && !candidate.usable[i]) continue;
+    points.push_back(candidate.points_map[i]);
+    covs.push_back(candidate.cov_map.empty() ? Eigen::Matrix2d::Zero() : candidate.cov_map[i]);
+  }
+  if (points.size() < 2) return -1.0;
+  const double floor = options.lane_position_sigma_m * options.lane_position_sigma_m;
   const CatmullRomSpline spline(lane.control_points_map);
   // Observation direction: from its first to its last point (ordered along the lane).
-  Eigen::Vector2d obs_dir = (candidate.points_map.back() - candidate.points_map.front()).head<2>();
+  Eigen::Vector2d obs_dir = (points.back() - points.front()).head<2>();
   if (obs_dir.norm() < 1e-6) return -1.0;
   obs_dir.normalize();
 
   // Use at most ~12 points spread over the observation: association runs every frame.
-  const std::size_t n = candidate.points_map.size();
+  const std::size_t n = points.size();
   const std::size_t step = std::max<std::size_t>(1, n / 12);
-  std::vector<double> lateral;
+  std::vector<double> lateral, normalized;
   int used = 0, direction_votes = 0, direction_ok = 0;
   const double end_s = spline.NumSegments();
   for (std::size_t i = 0; i < n; i += step, ++used) {
-    const Eigen::Vector3d& p = candidate.points_map[i];
+    const Eigen::Vector3d& p = points[i];
     const CatmullRomSpline::ClosestPoint closest = spline.FindClosest(p);
     Eigen::Vector2d tangent = spline.Derivative(closest.s).head<2>();
     if (tangent.norm() < 1e-9) continue;
@@ -105,9 +127,13 @@ double LaneAssociationCost(const LaneElement& lane, const LaneCandidate& candida
     const bool at_end = closest.s <= 1e-6 || closest.s >= end_s - 1e-6;
     if (at_end && std::abs(along) > options.lane_max_end_gap_m) continue;
     // Past an end, the lateral distance is measured to the end tangent line.
-    const double lateral_m = at_end ? std::abs(offset.x() * tangent.y() - offset.y() * tangent.x())
-                                    : offset.norm();
+    const double lateral_m =
+        at_end ? std::abs(offset.x() * tangent.y() - offset.y() * tangent.x()) : offset.norm();
+    // The point's IPM variance across the lane (normal n of the tangent) plus the floor.
+    const Eigen::Vector2d normal(-tangent.y(), tangent.x());
+    const double variance = normal.dot(covs[i] * normal) + floor;
     lateral.push_back(lateral_m);
+    normalized.push_back(lateral_m / std::sqrt(variance));
     ++direction_votes;
     if (std::abs(tangent.dot(obs_dir)) >= options.lane_min_direction_cos) ++direction_ok;
   }
@@ -115,9 +141,11 @@ double LaneAssociationCost(const LaneElement& lane, const LaneCandidate& candida
     return -1.0;
   }
   if (direction_ok * 2 < direction_votes) return -1.0;
-  std::nth_element(lateral.begin(), lateral.begin() + lateral.size() / 2, lateral.end());
-  const double median = lateral[lateral.size() / 2];
-  return median <= options.lane_gate_m ? median : -1.0;
+  const std::size_t mid = lateral.size() / 2;
+  std::nth_element(lateral.begin(), lateral.begin() + mid, lateral.end());
+  std::nth_element(normalized.begin(), normalized.begin() + mid, normalized.end());
+  if (lateral[mid] > options.lane_gate_m || normalized[mid] > options.lane_gate_sigmas) return -1.0;
+  return normalized[mid];
 }
 
 std::vector<int> AssociateLanes(const std::vector<LaneElement>& lanes,

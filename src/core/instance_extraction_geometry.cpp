@@ -37,10 +37,16 @@ int Root(std::vector<int>* parent, int i) {
   return i;
 }
 
-// Indices of the runs of the largest 8-connected piece (most pixels; ties: the piece whose
-// first run comes first), in row-major order. Runs of consecutive rows are linked when they
-// overlap or touch diagonally; a two-pointer sweep over each pair of rows keeps it linear.
-std::vector<int> LargestComponent(const Run* runs, int run_count) {
+// A piece of an instance smaller than this fraction of its largest piece is segmentation
+// debris and is left out of the marking's outline; larger ones (the glyphs of a speed limit,
+// the parts of an arrow cut by a gap) belong to the marking.
+constexpr double kMinPieceFraction = 0.1;
+
+// Indices of the runs of the instance's significant 8-connected pieces (those with at least
+// kMinPieceFraction of the largest piece's pixels), in row-major order. Runs of consecutive
+// rows are linked when they overlap or touch diagonally; a two-pointer sweep over each pair
+// of rows keeps it linear.
+std::vector<int> SignificantPieces(const Run* runs, int run_count) {
   std::vector<int> parent(run_count);
   for (int i = 0; i < run_count; ++i) parent[i] = i;
   int previous_begin = 0, previous_end = 0;  // runs of the row above the current one
@@ -73,14 +79,11 @@ std::vector<int> LargestComponent(const Run* runs, int run_count) {
   for (int i = 0; i < run_count; ++i) {
     pixels[Root(&parent, i)] += runs[i].last_col - runs[i].first_col + 1;
   }
-  int best_root = -1;
-  for (int i = 0; i < run_count; ++i) {
-    const int root = Root(&parent, i);
-    if (best_root < 0 || pixels[root] > pixels[best_root]) best_root = root;
-  }
+  int largest = 0;
+  for (int i = 0; i < run_count; ++i) largest = std::max(largest, pixels[Root(&parent, i)]);
   std::vector<int> members;
   for (int i = 0; i < run_count; ++i) {
-    if (Root(&parent, i) == best_root) members.push_back(i);
+    if (pixels[Root(&parent, i)] >= kMinPieceFraction * largest) members.push_back(i);
   }
   return members;
 }
@@ -203,9 +206,10 @@ void OrderCornersCanonically(std::array<Eigen::Vector3d, 4>* corners_base) {
 }
 
 GeometryOutcome ExtractMarking(const Run* runs, int run_count, const Ipm& ipm,
-                               const ExtractionOptions& options, MarkingObservation* marking) {
+                               const IpmErrorModel& error_model, const ExtractionOptions& options,
+                               MarkingObservation* marking) {
   const std::vector<Eigen::Vector2d> outline_uv =
-      SubpixelOutline(RowEnds(runs, LargestComponent(runs, run_count)));
+      SubpixelOutline(RowEnds(runs, SignificantPieces(runs, run_count)));
   std::vector<cv::Point2f> outline_mm;
   outline_mm.reserve(outline_uv.size());
   for (const Eigen::Vector2d& uv : outline_uv) {
@@ -235,6 +239,14 @@ GeometryOutcome ExtractMarking(const Run* runs, int run_count, const Ipm& ipm,
       return GeometryOutcome::kRange;
     }
   }
+  marking->center_base = 0.25 * (marking->corners_base[0] + marking->corners_base[1] +
+                                 marking->corners_base[2] + marking->corners_base[3]);
+  Eigen::Vector2d center_uv;
+  if (!ipm.BaseToPixel(marking->center_base, &center_uv)) return GeometryOutcome::kRange;
+  const std::optional<IpmUncertainty> uncertainty =
+      ComputeIpmUncertainty(ipm.camera(), ipm.T_base_cam(), center_uv, error_model);
+  if (!uncertainty) return GeometryOutcome::kRange;
+  marking->center_cov_base = uncertainty->omega.topLeftCorner<2, 2>();
   return GeometryOutcome::kOk;
 }
 
@@ -261,6 +273,7 @@ GeometryOutcome ExtractLane(const Run* runs, int run_count, const Ipm& ipm,
         if (!uncertainty) continue;
         point.uv = uv;
         point.score = uncertainty->score;
+        point.cov_base = uncertainty->omega.topLeftCorner<2, 2>();
         lane->points.push_back(point);
       }
     }

@@ -50,13 +50,15 @@ MaskRuns ScanMask(const cv::Mat& mask);
 // Why the geometry of one instance was rejected.
 enum class GeometryOutcome { kOk, kRange, kDegenerate };
 
-// Marking rectangle from the runs of one instance (row-major). The outline is that of the
-// largest 8-connected piece; each row end contributes the midpoints of its pixel's four
-// edges (the 50%-coverage edge lies between an inside and an outside pixel center). All of
-// them are mapped to the ground (any failure: kRange, the marking is cut by the horizon or
+// Marking rectangle from the runs of one instance (row-major). The outline is the sub-pixel
+// convex outline of the instance's significant 8-connected pieces (all glyphs of a text
+// marking; specks below a tenth of the largest piece are debris). All of its points are
+// mapped to the ground (any failure: kRange, the marking is cut by the horizon or
 // the IPM range), then the minimum-area rectangle is taken and ordered canonically.
+// The rectangle's center also gets the x-y block of Omega_p at its pixel (center_cov_base).
 GeometryOutcome ExtractMarking(const Run* runs, int run_count, const Ipm& ipm,
-                               const ExtractionOptions& options, MarkingObservation* marking);
+                               const IpmErrorModel& error_model, const ExtractionOptions& options,
+                               MarkingObservation* marking);
 
 // Lane centerline points from the runs of one instance (row-major): every
 // options.lane_row_step rows from the bottom row up, the center of each run of that row,

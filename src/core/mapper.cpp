@@ -51,14 +51,13 @@ std::string Mapper::ValidateInput(const FrameInput& input) const {
   if (!std::isfinite(input.stamp)) return "bad_stamp: stamp is not finite";
   if (input.stamp <= last_stamp_) {
     std::ostringstream s;
-    s << "time_jump: stamp " << input.stamp << " s is not after the last frame's "
-      << last_stamp_ << " s";
+    s << "time_jump: stamp " << input.stamp << " s is not after the last frame's " << last_stamp_
+      << " s";
     return s.str();
   }
   const std::string camera_error = PinholeCamera(input.camera).Validate();
   if (!camera_error.empty()) return "bad_camera: " + camera_error;
-  const std::string mask_error =
-      ValidateMask(input.mask, input.camera.width, input.camera.height);
+  const std::string mask_error = ValidateMask(input.mask, input.camera.width, input.camera.height);
   if (!mask_error.empty()) return "bad_mask: " + mask_error;
   if (!IsValidTransform(input.T_map_base_odom)) {
     return "bad_pose: odometry pose is not finite or not a rotation";
@@ -78,8 +77,8 @@ FrameStatus Mapper::ProcessFrame(const FrameInput& input, std::string* reason) {
   ApplyBackendResults();
 
   const Ipm ipm(PinholeCamera(input.camera), T_base_cam_, options_.ipm.max_range_m);
-  FrameObservations observations = ExtractObservations(
-      input.mask, classes_, ipm, options_.ipm.error_model, options_.extraction);
+  FrameObservations observations =
+      ExtractObservations(input.mask, classes_, ipm, options_.ipm.error_model, options_.extraction);
   counters_.extraction.Add(observations.counters);
 
   FrameRecord frame;
@@ -106,10 +105,11 @@ void Mapper::AddMarkings(const FrameObservations& observations, const FrameRecor
     MarkingCandidate candidate;
     candidate.class_id = obs.class_id;
     for (int i = 0; i < 4; ++i) candidate.corners_map[i] = frame.T_map_base * obs.corners_base[i];
+    const Eigen::Matrix2d R = frame.T_map_base.linear().topLeftCorner<2, 2>();
+    candidate.center_cov_map = R * obs.center_cov_base * R.transpose();
     candidates.push_back(candidate);
   }
-  const std::vector<int> match =
-      AssociateMarkings(map_.markings, candidates, options_.association);
+  const std::vector<int> match = AssociateMarkings(map_.markings, candidates, options_.association);
   for (std::size_t c = 0; c < candidates.size(); ++c) {
     const MarkingObservation& obs = observations.markings[c];
     if (match[c] < 0) {
@@ -117,6 +117,7 @@ void Mapper::AddMarkings(const FrameObservations& observations, const FrameRecor
       element.id = map_.next_id++;
       element.class_id = obs.class_id;
       element.corners_map = candidates[c].corners_map;
+      element.center_cov_map = candidates[c].center_cov_map;
       element.history.push_back({frame.index, obs.corners_uv, obs.corners_base});
       element.first_frame = element.last_frame = frame.index;
       element.first_seen = element.last_seen = frame.stamp;
@@ -135,189 +136,15 @@ void Mapper::AddMarkings(const FrameObservations& observations, const FrameRecor
     element.history.push_back(measurement);
     element.last_frame = frame.index;
     element.last_seen = frame.stamp;
+    if (candidates[c].center_cov_map.trace() < element.center_cov_map.trace()) {
+      element.center_cov_map = candidates[c].center_cov_map;
+    }
     if (element.optimized) continue;  // the back end owns the estimate
     // Plain IPM estimate: the running mean of the observed corners in the map.
     const double n = static_cast<double>(element.history.size());
     for (int i = 0; i < 4; ++i) {
-      element.corners_map[i] += (candidates[c].corners_map[(i + shift) % 4] -
-                                 element.corners_map[i]) / n;
-    }
-  }
-}
-
-namespace {
-
-// Point selection (PS): flags of the points kept for control-point estimation.
-std::vector<std::uint8_t> SelectPoints(const std::vector<LanePoint>& points,
-                                       const LaneOptions& options) {
-  std::vector<std::uint8_t> selected(points.size(), options.point_selection ? 0 : 1);
-  if (!options.point_selection) return selected;
-  std::vector<double> scores;
-  scores.reserve(points.size());
-  for (const LanePoint& p : points) {
-    scores.push_back(p.score <= options.max_selected_score_m2 ? p.score
-                                                               : std::nan(""));
-  }
-  for (std::size_t i : SelectLowestScores(scores, options.selected_points_per_frame)) {
-    selected[i] = 1;
-  }
-  return selected;
-}
-
-double Extent(const std::vector<Eigen::Vector3d>& points) {
-  double extent = 0.0;
-  for (std::size_t i = 1; i < points.size(); ++i) {
-    extent = std::max(extent, (points[i] - points.front()).head<2>().norm());
-  }
-  return extent;
-}
-
-}  // namespace
-
-void Mapper::AddLanes(const FrameObservations& observations, const FrameRecord& frame) {
-  std::vector<LaneCandidate> candidates;
-  std::vector<LaneMeasurement> measurements;
-  for (const LaneObservation& obs : observations.lanes) {
-    LaneCandidate candidate;
-    candidate.class_id = obs.class_id;
-    for (const LanePoint& p : obs.points) candidate.points_map.push_back(frame.T_map_base * p.p_base);
-    LaneMeasurement measurement;
-    measurement.frame_index = frame.index;
-    measurement.points = obs.points;
-    measurement.selected = SelectPoints(obs.points, options_.lanes);
-    candidates.push_back(std::move(candidate));
-    measurements.push_back(std::move(measurement));
-  }
-  const std::vector<int> match = AssociateLanes(map_.lanes, candidates, options_.association);
-  bool merge_due = false;
-  for (std::size_t c = 0; c < candidates.size(); ++c) {
-    std::vector<Eigen::Vector3d> selected_map;
-    for (std::size_t i = 0; i < candidates[c].points_map.size(); ++i) {
-      if (measurements[c].selected[i]) selected_map.push_back(candidates[c].points_map[i]);
-    }
-    if (match[c] < 0) {
-      // The start gate looks at every point PS would accept by score: the N best alone
-      // may all lie on the nearest dash of a dashed line, shorter than the gate.
-      std::vector<Eigen::Vector3d> usable_map;
-      for (std::size_t i = 0; i < candidates[c].points_map.size(); ++i) {
-        if (measurements[c].points[i].score <= options_.lanes.max_selected_score_m2) {
-          usable_map.push_back(candidates[c].points_map[i]);
-        }
-      }
-      StartLane(candidates[c].class_id, measurements[c], selected_map, usable_map, frame);
-      continue;
-    }
-    LaneElement& lane = map_.lanes[match[c]];
-    lane.history.push_back(std::move(measurements[c]));
-    std::vector<Eigen::Vector3d> grown =
-        ExtendControlPoints(lane.control_points_map, selected_map, options_.lanes.fit);
-    // Growth at the start shifts the indices: find the old c2 again in the new vector
-    // (extension may re-place an end point, c1, but keeps the interior bit for bit). If it
-    // is not found, older back-end results for this lane no longer apply.
-    bool found = false;
-    for (std::size_t offset = 0; offset + 2 < grown.size() && offset < grown.size(); ++offset) {
-      if (grown[offset + 2] == lane.control_points_map[2]) {
-        lane.first_cp_index -= static_cast<std::int64_t>(offset);
-        found = true;
-        break;
-      }
-    }
-    if (!found) lane.first_cp_index -= 1000000;
-    lane.control_points_map = std::move(grown);
-    lane.last_frame = frame.index;
-    lane.last_seen = frame.stamp;
-    if (!LanesRefinedByBackend() &&
-        lane.history.size() % options_.lanes.refit_every_n_frames == 0) {
-      RefitLane(&lane);
-      merge_due = true;
-    }
-  }
-  // After the loop: merging erases lanes, which would invalidate the indices in `match`.
-  if (merge_due) MergeLanes();
-}
-
-void Mapper::StartLane(int class_id, const LaneMeasurement& measurement,
-                       const std::vector<Eigen::Vector3d>& selected_map,
-                       const std::vector<Eigen::Vector3d>& usable_map,
-                       const FrameRecord& frame) {
-  if (Extent(usable_map) < options_.lanes.min_new_lane_length_m) {
-    ++counters_.lane_observations_unused;
-    return;
-  }
-  auto control_points = EstimateControlPoints(selected_map, options_.lanes.fit);
-  if (!control_points) control_points = EstimateControlPoints(usable_map, options_.lanes.fit);
-  if (!control_points) {
-    ++counters_.lane_observations_unused;
-    return;
-  }
-  LaneElement lane;
-  lane.id = map_.next_id++;
-  lane.class_id = class_id;
-  lane.control_points_map = *control_points;
-  lane.history.push_back(measurement);
-  lane.history_at_last_refit = 1;
-  lane.first_frame = lane.last_frame = frame.index;
-  lane.first_seen = lane.last_seen = frame.stamp;
-  map_.lanes.push_back(std::move(lane));
-  ++counters_.lanes_created;
-}
-
-std::vector<Eigen::Vector3d> Mapper::SelectedPointsMap(const LaneElement& lane) const {
-  const Ipm ipm(PinholeCamera(camera_), T_base_cam_, options_.ipm.max_range_m);
-  std::vector<Eigen::Vector3d> points;
-  for (const LaneMeasurement& m : lane.history) {
-    const Eigen::Isometry3d& T_map_base = map_.frames[m.frame_index].T_map_base;
-    for (std::size_t i = 0; i < m.points.size(); ++i) {
-      Eigen::Vector3d p_base;
-      if (m.selected[i] && ipm.PixelToGround(m.points[i].uv, &p_base) == IpmStatus::kOk) {
-        points.push_back(T_map_base * p_base);
-      }
-    }
-  }
-  return points;
-}
-
-void Mapper::RefitLane(LaneElement* lane) const {
-  if (lane->history_at_last_refit == lane->history.size()) return;
-  const auto control_points = EstimateControlPoints(SelectedPointsMap(*lane), options_.lanes.fit);
-  if (control_points) {
-    // A refit renumbers the control points: results of older windows no longer apply.
-    lane->control_points_map = *control_points;
-    lane->first_cp_index -= 1000000;
-  }
-  lane->history_at_last_refit = lane->history.size();
-}
-
-void Mapper::MergeLanes() {
-  // Two lanes of one class that turn out to be one line (e.g. one was started while the
-  // other was not matched across a gap): the second's curve lies along the first.
-  for (std::size_t a = 0; a < map_.lanes.size(); ++a) {
-    for (std::size_t b = a + 1; b < map_.lanes.size();) {
-      LaneElement& first = map_.lanes[a];
-      LaneElement& second = map_.lanes[b];
-      LaneCandidate candidate;
-      candidate.class_id = second.class_id;
-      candidate.points_map = second.control_points_map;  // ordered along the lane
-      candidate.points_map.erase(candidate.points_map.begin());  // phantom ends out
-      candidate.points_map.pop_back();
-      if (candidate.points_map.size() < 2 ||
-          LaneAssociationCost(first, candidate, options_.association) < 0.0) {
-        ++b;
-        continue;
-      }
-      first.history.insert(first.history.end(), second.history.begin(), second.history.end());
-      std::sort(first.history.begin(), first.history.end(),
-                [](const LaneMeasurement& x, const LaneMeasurement& y) {
-                  return x.frame_index < y.frame_index;
-                });
-      first.first_frame = std::min(first.first_frame, second.first_frame);
-      first.last_frame = std::max(first.last_frame, second.last_frame);
-      first.first_seen = std::min(first.first_seen, second.first_seen);
-      first.last_seen = std::max(first.last_seen, second.last_seen);
-      first.history_at_last_refit = 0;
-      RefitLane(&first);
-      map_.lanes.erase(map_.lanes.begin() + b);
-      ++counters_.lanes_merged;
+      element.corners_map[i] +=
+          (candidates[c].corners_map[(i + shift) % 4] - element.corners_map[i]) / n;
     }
   }
 }
@@ -436,7 +263,9 @@ VectorMap Mapper::ExportMap() const {
     const ClassInfo* info = classes_.Find(class_id);
     return info ? info->name : std::string("class_") + std::to_string(class_id);
   };
+  // An element seen once is tentative (a spurious blob, until seen again): not exported.
   for (const MarkingElement& element : map_.markings) {
+    if (element.history.size() < 2) continue;
     MapMarking marking;
     marking.id = element.id;
     marking.class_id = element.class_id;
@@ -448,18 +277,17 @@ VectorMap Mapper::ExportMap() const {
     out.markings.push_back(marking);
   }
   for (const LaneElement& element : map_.lanes) {
-    LaneElement refit = element;
-    if (!LanesRefinedByBackend()) {
-      refit.history_at_last_refit = 0;  // re-IPM with the final extrinsic and poses
-      RefitLane(&refit);
-    }
+    if (element.history.size() < 2) continue;
     MapLane lane;
     lane.id = element.id;
     lane.class_id = element.class_id;
     lane.class_name = class_name(element.class_id);
     const ClassInfo* info = classes_.Find(element.class_id);
     lane.style = info ? ToString(info->style) : "unknown";
-    lane.control_points_map = refit.control_points_map;
+    // Lanes no lane residual refines are re-fit to all their points, re-IPMed with the final
+    // extrinsic and poses (PGO-IPM: lanes follow the refined extrinsic).
+    lane.control_points_map =
+        LanesRefinedByBackend() ? element.control_points_map : RefitControlPoints(element);
     lane.observations = static_cast<int>(element.history.size());
     lane.first_seen = element.first_seen;
     lane.last_seen = element.last_seen;
@@ -480,8 +308,9 @@ VectorMap Mapper::ExportMap() const {
     std::vector<double> times = stats.solve_times_s;
     std::sort(times.begin(), times.end());
     auto quantile = [&times](double q) {
-      return times.empty() ? 0.0 : times[std::min(times.size() - 1,
-                                                   static_cast<std::size_t>(q * times.size()))];
+      return times.empty()
+                 ? 0.0
+                 : times[std::min(times.size() - 1, static_cast<std::size_t>(q * times.size()))];
     };
     out.metadata["backend_solves"] = stats.solved;
     out.metadata["backend_dropped_queue_full"] = stats.dropped_queue_full;

@@ -38,7 +38,15 @@ LaneOptions LoadLaneOptions(OptionsReader reader) {
   reader.Read<double>("max_selected_score_m2", &o.max_selected_score_m2, CheckPositive);
   reader.Read<double>("chord_spacing_m", &o.fit.chord_spacing_m, CheckPositive);
   reader.Read<double>("smoothing_length_m", &o.fit.smoothing_length_m, CheckPositive);
-  reader.Read<int>("refit_every_n_frames", &o.refit_every_n_frames, CheckPositiveInt);
+  o.end_fit.chord_spacing_m = o.fit.chord_spacing_m;
+  reader.Read<int>("end_fit_frames", &o.end_fit_frames, CheckPositiveInt);
+  reader.Read<int>("end_fit_min_points", &o.end_fit.min_points_to_extend, CheckPositiveInt);
+  reader.Read<double>("end_fit_max_point_distance_m", &o.end_fit.max_point_distance_m,
+                      CheckPositive);
+  reader.Read<double>("end_fit_smoothness", &o.end_fit.smoothness_weight, CheckNonNegative);
+  reader.Read<double>("end_fit_prior_sigma_m", &o.end_fit.prior_sigma_m, CheckPositive);
+  reader.Read<double>("end_fit_robust_scale_m", &o.end_fit.robust_scale_m, CheckPositive);
+  reader.Read<int>("merge_every_n_frames", &o.merge_every_n_frames, CheckPositiveInt);
   reader.Read<double>("min_new_lane_length_m", &o.min_new_lane_length_m, CheckNonNegative);
   reader.RejectUnknownKeys();
   return o;
@@ -88,7 +96,9 @@ std::string ToString(const MapperOptions& o) {
     << "lanes.point_selection: " << (o.lanes.point_selection ? "true" : "false") << "\n"
     << "lanes.selected_points_per_frame: " << o.lanes.selected_points_per_frame << "\n"
     << "lanes.chord_spacing_m: " << o.lanes.fit.chord_spacing_m << "\n"
-    << "association.marking_gate_m: " << o.association.marking_gate_m << "\n"
+    << "association.marking_gate_sigmas: " << o.association.marking_gate_sigmas << "\n"
+    << "association.marking_position_sigma_m: " << o.association.marking_position_sigma_m << "\n"
+    << "association.lane_max_point_score_m2: " << o.association.lane_max_point_score_m2 << "\n"
     << "association.lane_gate_m: " << o.association.lane_gate_m << "\n";
   return s.str();
 }

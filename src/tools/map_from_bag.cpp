@@ -191,7 +191,7 @@ std::string Summary(const Arguments& args, const Mapper& mapper, const FrameAsse
     << "map: " << map.markings.size() << " markings, " << map.lanes.size() << " lanes (created "
     << c.markings_created << " markings, " << c.lanes_created << " lanes; spurious dropped "
     << c.spurious_dropped << ", lanes merged " << c.lanes_merged << ", lane observations unused "
-    << c.lane_observations_unused << ")\n"
+    << c.lane_observations_unused << ", near a lane " << c.lane_observations_near_lane << ")\n"
     << BackendLine(mapper) << "\n"
     << "wall time: " << stats.wall_s << " s; "
     << (stats.wall_s > 0 ? stats.frames_read / stats.wall_s : 0.0) << " frames/s; bag span "

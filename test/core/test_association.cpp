@@ -1,8 +1,8 @@
-#include "ipm_road_mapper/core/association.h"
-
 #include <gtest/gtest.h>
 
 #include <cmath>
+
+#include "ipm_road_mapper/core/association.h"
 
 namespace ipm_road_mapper {
 namespace {
@@ -71,22 +71,69 @@ TEST(AssociateMarkings, OneToOneWithinAFrame) {
   EXPECT_EQ(match, (std::vector<int>{-1, 0}));  // the closer one wins, the other is new
 }
 
+TEST(AssociateMarkings, GateFollowsTheIpmCovariance) {
+  // Far away, plain IPM errs along the viewing ray (here map x) by meters but across it by
+  // centimeters: 2 m along the ray is the same marking, 1.2 m across it is another one.
+  const std::vector<MarkingElement> elements = {Marking(10, 20, 0)};
+  MarkingCandidate along{10, Rectangle(22.0, 0, 3, 1)};
+  along.center_cov_map << 1.2 * 1.2, 0, 0, 0.04 * 0.04;
+  MarkingCandidate across{10, Rectangle(20.0, 1.2, 3, 1)};
+  across.center_cov_map = along.center_cov_map;
+  const AssociationOptions options;
+  EXPECT_EQ(AssociateMarkings(elements, {along}, options), (std::vector<int>{0}));
+  EXPECT_EQ(AssociateMarkings(elements, {across}, options), (std::vector<int>{-1}));
+  // Without the covariance, 2 m is beyond the gate of the isotropic floor.
+  MarkingCandidate along_no_cov{10, Rectangle(22.0, 0, 3, 1)};
+  EXPECT_EQ(AssociateMarkings(elements, {along_no_cov}, options), (std::vector<int>{-1}));
+  EXPECT_GT(MarkingAssociationCost(elements[0], along_no_cov, options),
+            MarkingAssociationCost(elements[0], along, options));
+}
+
+TEST(AssociateLanes, IgnoresPointsMarkedUnusable) {
+  const std::vector<LaneElement> lanes = {StraightLane(2, 0.0, 0, 30)};
+  // Near points on the line, far points 1.5 m off (an outer line seen far away).
+  LaneCandidate candidate = LinePoints(2, 0.1, 5, 15);
+  const std::size_t near = candidate.points_map.size();
+  for (double x = 16; x <= 30; x += 1.0) candidate.points_map.emplace_back(x, 1.5, 0.0);
+  EXPECT_LT(LaneAssociationCost(lanes[0], candidate, AssociationOptions()), 0.0);
+  candidate.usable.assign(candidate.points_map.size(), false);
+  for (std::size_t i = 0; i < near; ++i) candidate.usable[i] = true;
+  const AssociationOptions options;
+  EXPECT_NEAR(LaneAssociationCost(lanes[0], candidate, options),
+              0.1 / options.lane_position_sigma_m, 1e-6);
+}
+
 TEST(AssociateLanes, MatchesByLateralDistanceAndClass) {
-  const std::vector<LaneElement> lanes = {StraightLane(2, 0.0, 0, 30),
-                                          StraightLane(2, 3.5, 0, 30),
+  const std::vector<LaneElement> lanes = {StraightLane(2, 0.0, 0, 30), StraightLane(2, 3.5, 0, 30),
                                           StraightLane(1, -3.5, 0, 30)};
   const std::vector<LaneCandidate> candidates = {
       LinePoints(2, 3.3, 5, 25), LinePoints(2, 0.2, 5, 25), LinePoints(2, -3.5, 5, 25),
-      LinePoints(2, 1.75, 5, 25)};  // halfway between two lanes: beyond the 0.8 m gate
+      LinePoints(2, 1.75, 5, 25)};  // halfway between two lanes: beyond the gates
   const auto match = AssociateLanes(lanes, candidates, AssociationOptions());
   EXPECT_EQ(match, (std::vector<int>{1, 0, -1, -1}));
+}
+
+TEST(AssociateLanes, LateralGateFollowsTheIpmCovariance) {
+  // An outer line 5 m to the side seen at 10 m: plain IPM puts it 0.7 m off when the body
+  // pitches, which is within its lateral sigma (0.25 m, plus the floor) but not within the
+  // floor alone.
+  const std::vector<LaneElement> lanes = {StraightLane(3, 5.0, 0, 30)};
+  LaneCandidate candidate = LinePoints(3, 5.7, 9, 14);
+  EXPECT_EQ(AssociateLanes(lanes, {candidate}, AssociationOptions())[0], -1);
+  Eigen::Matrix2d cov;
+  cov << 0.4 * 0.4, 0.4 * 0.25 * 0.9, 0.4 * 0.25 * 0.9, 0.25 * 0.25;
+  candidate.cov_map.assign(candidate.points_map.size(), cov);
+  EXPECT_EQ(AssociateLanes(lanes, {candidate}, AssociationOptions())[0], 0);
+  // Beyond the hard cap in meters, no covariance helps.
+  LaneCandidate far = LinePoints(3, 6.5, 9, 14);
+  far.cov_map.assign(far.points_map.size(), 100.0 * cov);
+  EXPECT_EQ(AssociateLanes(lanes, {far}, AssociationOptions())[0], -1);
 }
 
 TEST(AssociateLanes, PointsPastTheEndExtendTheLane) {
   const std::vector<LaneElement> lanes = {StraightLane(2, 0.0, 0, 30)};
   // Starts 2 m before the lane's end and runs 20 m past it, 0.1 m off the line.
-  const auto match =
-      AssociateLanes(lanes, {LinePoints(2, 0.1, 28, 50)}, AssociationOptions());
+  const auto match = AssociateLanes(lanes, {LinePoints(2, 0.1, 28, 50)}, AssociationOptions());
   EXPECT_EQ(match[0], 0);
   // Far past the end (beyond lane_max_end_gap_m): a new lane.
   const auto far = AssociateLanes(lanes, {LinePoints(2, 0.0, 60, 80)}, AssociationOptions());
@@ -105,11 +152,11 @@ TEST(AssociationOptions, RejectsUnknownAndBadKeys) {
   EXPECT_THROW(LoadAssociationOptions(OptionsReader(YAML::Load("lane_gate: 1.0"), "association")),
                OptionsError);
   EXPECT_THROW(
-      LoadAssociationOptions(OptionsReader(YAML::Load("marking_gate_m: -1"), "association")),
+      LoadAssociationOptions(OptionsReader(YAML::Load("marking_gate_sigmas: -1"), "association")),
       OptionsError);
   const auto o =
-      LoadAssociationOptions(OptionsReader(YAML::Load("marking_gate_m: 2.5"), "association"));
-  EXPECT_DOUBLE_EQ(o.marking_gate_m, 2.5);
+      LoadAssociationOptions(OptionsReader(YAML::Load("marking_gate_sigmas: 2.5"), "association"));
+  EXPECT_DOUBLE_EQ(o.marking_gate_sigmas, 2.5);
 }
 
 }  // namespace

@@ -191,7 +191,20 @@ TEST_F(InstanceExtractionTest, ThinRectangleIsDegenerate) {
   EXPECT_EQ(obs.counters.dropped_degenerate, 1u);
 }
 
-TEST_F(InstanceExtractionTest, MarkingUsesItsLargestPieceOnly) {
+TEST_F(InstanceExtractionTest, MarkingRectangleSpansAllItsGlyphs) {
+  // A speed limit "60": two glyphs of one instance, side by side across the road. The
+  // marking is their common bounding rectangle (off the x axis, so that one corner is the
+  // nearest), not the larger glyph (which would make the
+  // observed rectangle jump between glyphs from frame to frame).
+  cv::Mat mask = EmptyMask();
+  RenderGroundRectangle(ipm_, {10.0, 0.15}, 1.4, 0.6, 0.0, kArrow, &mask);
+  RenderGroundRectangle(ipm_, {10.0, 1.05}, 1.4, 0.6, 0.0, kArrow, &mask);
+  const FrameObservations obs = Extract(mask);
+  ASSERT_EQ(obs.markings.size(), 1u);
+  EXPECT_LT(MaxCornerError(obs.markings[0], GroundRectangle({10.0, 0.6}, 1.4, 1.5, 0.0)), 0.05);
+}
+
+TEST_F(InstanceExtractionTest, MarkingLeavesOutSpecksOfItsInstance) {
   cv::Mat mask = EmptyMask();
   // Off the x axis: a rectangle centered on it has two corners equally near the origin.
   RenderGroundRectangle(ipm_, {10.0, 0.4}, 2.0, 0.5, 0.0, kArrow, &mask);

@@ -1,8 +1,13 @@
 // Data association of one frame's observations with the map's elements: gated and
 // class-aware, one-to-one within a frame (greedy by increasing cost).
-//  - markings: center distance within a gate, then the best cyclic order of the corners;
+//  - markings: Mahalanobis distance of the centers in x-y, with the covariance of plain IPM
+//    at each (Omega_p: at 20 m a pitch error of 0.3 deg moves a marking 1.4 m along the
+//    road but 4 cm across it) plus an isotropic floor; then the best cyclic order of the
+//    corners;
 //  - lanes: lateral distance of the observation's points to the element's spline (or to
-//    its end tangent, for points just past an end) and direction agreement.
+//    its end tangent, for points just past an end), in units of each point's lateral IPM
+//    sigma (outer lines seen at 10 m stray by +-0.5 m as the body pitches), and direction
+//    agreement.
 #pragma once
 
 #include <Eigen/Core>
@@ -16,12 +21,20 @@ namespace ipm_road_mapper {
 
 // Gates of the association (config section `association`).
 struct AssociationOptions {
-  double marking_gate_m = 1.5;        // max center distance between observation and element
-  double lane_gate_m = 0.8;           // max median lateral distance to the lane
+  double marking_gate_sigmas = 3.0;  // max Mahalanobis distance of the centers
+  // Isotropic floor of the gate's covariance (pose noise, shape, segmentation); crosswalk
+  // stripes 1 m apart must stay apart: 3 sigma of the floor is 0.75 m.
+  double marking_position_sigma_m = 0.25;
+  // Lane points whose tr(Omega_p) exceeds this are not used to associate (or start) a lane:
+  // far points of outer lines stray laterally by up to a meter.
+  double lane_max_point_score_m2 = 1.0;
+  double lane_gate_m = 1.2;             // max median lateral distance to the lane (hard cap)
+  double lane_gate_sigmas = 3.0;        // max median lateral distance in IPM sigmas (below)
+  double lane_position_sigma_m = 0.15;  // floor of a point's lateral sigma (pose, lane noise)
   double lane_min_direction_cos = 0.9;  // min |cos| between observation and lane directions
-  double lane_max_end_gap_m = 15.0;   // points this far past a lane end still count (growth)
-  double lane_min_support = 0.3;      // fraction of the observation's points that must count
-  int spurious_after_frames = 10;     // element seen once, unseen for this many frames: dropped
+  double lane_max_end_gap_m = 15.0;     // points this far past a lane end still count (growth)
+  double lane_min_support = 0.3;        // fraction of the observation's points that must count
+  int spurious_after_frames = 10;       // element seen once, unseen for this many frames: dropped
 };
 
 // Reads the `association` section; throws OptionsError naming the bad key.
@@ -36,7 +49,12 @@ int BestCyclicShift(const std::array<Eigen::Vector3d, 4>& element,
 struct MarkingCandidate {
   int class_id = 0;
   std::array<Eigen::Vector3d, 4> corners_map;
+  Eigen::Matrix2d center_cov_map = Eigen::Matrix2d::Zero();  // Omega_p (x-y) in the map frame
 };
+
+// Squared Mahalanobis distance of a candidate's center from an element's, in x-y.
+double MarkingAssociationCost(const MarkingElement& element, const MarkingCandidate& candidate,
+                              const AssociationOptions& options);
 
 // For each candidate, the index of its marking element or -1 (new element).
 std::vector<int> AssociateMarkings(const std::vector<MarkingElement>& elements,
@@ -47,10 +65,16 @@ std::vector<int> AssociateMarkings(const std::vector<MarkingElement>& elements,
 struct LaneCandidate {
   int class_id = 0;
   std::vector<Eigen::Vector3d> points_map;  // ordered along the lane
+  // Per point: low enough IPM uncertainty to associate with (empty: all points are).
+  std::vector<bool> usable;
+  // Per point: x-y block of Omega_p in the map frame (empty: zero).
+  std::vector<Eigen::Matrix2d> cov_map;
 };
 
-// Cost of explaining `candidate` by `lane` (median lateral distance, m); negative when the
-// lane is not a candidate (class, direction, support or gate fail).
+// Cost of explaining `candidate` by `lane`: the median lateral distance in sigmas (the
+// point's lateral Omega_p plus lane_position_sigma_m^2); negative when the lane is not a
+// candidate (class, direction, support, or either gate fails: lane_gate_sigmas on that
+// median, lane_gate_m on the median in meters).
 double LaneAssociationCost(const LaneElement& lane, const LaneCandidate& candidate,
                            const AssociationOptions& options);
 

@@ -35,8 +35,9 @@ std::string ValidateMask(const cv::Mat& mask, int expected_width, int expected_h
 // Extracts every instance of `mask` (which must pass ValidateMask; an unusable mask gives
 // nothing). One scan groups the pixels by value; unknown classes, tiny instances and markings
 // within border_margin_px of the border are dropped from its statistics; of the rest the
-// max_instances_per_frame largest are processed. Markings: sub-pixel outline of the largest
-// 8-connected piece -> IPM (any outline point failing: dropped_range) -> minimum-area
+// max_instances_per_frame largest are processed. Markings: sub-pixel outline of the
+// significant 8-connected pieces (every glyph of a text; specks under a tenth of the largest
+// piece are left out) -> IPM (any outline point failing: dropped_range) -> minimum-area
 // rectangle on the ground -> canonical corners, projected back for the pixel measurements.
 // Lanes: every lane_row_step rows from the bottom, the center column of each run of the
 // instance's pixels in that row -> IPM point + uncertainty score. Results sorted by value.

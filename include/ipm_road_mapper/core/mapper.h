@@ -42,6 +42,9 @@ struct MapperCounters {
   std::uint64_t spurious_dropped = 0;
   std::uint64_t lanes_merged = 0;
   std::uint64_t lane_observations_unused = 0;  // unmatched and too short / unfit to start a lane
+  // Unmatched but close to a lane of its class (within twice the gates): not a new line, so
+  // not started (a second spline along one line would be a duplicate).
+  std::uint64_t lane_observations_near_lane = 0;
   std::uint64_t results_applied = 0;           // back-end results merged into the map
   std::uint64_t results_rejected = 0;          // unusable (solver failure, trust bound)
   std::uint64_t SkippedTotal() const;
@@ -66,8 +69,9 @@ class Mapper {
   // End of input: solves the last window, waits for the optimizer and merges its results.
   void Finish();
 
-  // The map as exported (map.json). Lanes that no lane residual refines are re-estimated
-  // by g from all their selected pixels, re-IPMed with the current extrinsic and poses.
+  // The map as exported (map.json): every element seen at least twice (one seen once is
+  // tentative until seen again or dropped as spurious). Lanes that no lane residual refines
+  // are re-fit to all their selected pixels, re-IPMed with the current extrinsic and poses.
   VectorMap ExportMap() const;
 
   // Optimizer statistics (zeros without a back end).
@@ -89,13 +93,16 @@ class Mapper {
  private:
   std::string ValidateInput(const FrameInput& input) const;
   void AddMarkings(const FrameObservations& observations, const FrameRecord& frame);
+  // Lanes (mapper_lanes.cpp): association, start, growth, merging.
   void AddLanes(const FrameObservations& observations, const FrameRecord& frame);
   void StartLane(int class_id, const LaneMeasurement& measurement,
-                 const std::vector<Eigen::Vector3d>& selected_map,
                  const std::vector<Eigen::Vector3d>& usable_map, const FrameRecord& frame);
+  // Grows and refines the lane's ends from the selected points of its recent observations.
+  void GrowLane(LaneElement* lane, std::size_t frame_index) const;
   // Selected pixels of every observation of the lane, IPMed now and put in the map.
   std::vector<Eigen::Vector3d> SelectedPointsMap(const LaneElement& lane) const;
-  void RefitLane(LaneElement* lane) const;
+  // The lane's control points re-fit to all of SelectedPointsMap (export, merges).
+  std::vector<Eigen::Vector3d> RefitControlPoints(const LaneElement& lane) const;
   bool LanesRefinedByBackend() const;
   WindowSnapshot BuildSnapshot();
   void ApplyBackendResults();

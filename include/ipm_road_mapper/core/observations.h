@@ -4,6 +4,7 @@
 #pragma once
 
 #include <Eigen/Core>
+#include <Eigen/LU>
 #include <array>
 #include <cstdint>
 #include <string>
@@ -20,6 +21,10 @@ struct MarkingObservation {
   std::array<Eigen::Vector3d, 4> corners_base;
   // The same corners projected back into the image: the pixel measurements z_k.
   std::array<Eigen::Vector2d, 4> corners_uv;
+  // Center of the rectangle (mean of corners_base) and the x-y block of Omega_p at its
+  // pixel: how far plain IPM may have put it (m^2), for the association gate.
+  Eigen::Vector3d center_base = Eigen::Vector3d::Zero();
+  Eigen::Matrix2d center_cov_base = Eigen::Matrix2d::Zero();
   int pixel_count = 0;
 };
 
@@ -28,6 +33,7 @@ struct LanePoint {
   Eigen::Vector2d uv = Eigen::Vector2d::Zero();       // pixel (the PPSR measurement)
   Eigen::Vector3d p_base = Eigen::Vector3d::Zero();   // its IPM ground point
   double score = 0.0;                                 // tr(Omega_p), m^2
+  Eigen::Matrix2d cov_base = Eigen::Matrix2d::Zero();  // x-y block of Omega_p, m^2
 };
 
 // One lane instance of one frame (all dashes of one line share an instance).

@@ -33,6 +33,9 @@ struct MarkingElement {
   std::uint64_t id = 0;
   int class_id = 0;
   std::array<Eigen::Vector3d, 4> corners_map;  // current estimate
+  // x-y covariance of the estimate for association: Omega_p of the best observation (the
+  // plain-IPM errors of one element's observations are correlated, so no 1/n).
+  Eigen::Matrix2d center_cov_map = Eigen::Matrix2d::Zero();
   std::vector<MarkingMeasurement> history;
   std::size_t first_frame = 0, last_frame = 0;
   double first_seen = 0.0, last_seen = 0.0;
@@ -48,6 +51,9 @@ struct LaneMeasurement {
   std::size_t frame_index = 0;
   std::vector<LanePoint> points;
   std::vector<std::uint8_t> selected;  // 1 where PS kept the point (all 1 without PS)
+  // The selected points in the map frame, with the pose and extrinsic of observation time
+  // (what the growth of the lane's ends fits).
+  std::vector<Eigen::Vector3d> selected_map;
 };
 
 // A mapped lane line.
@@ -61,7 +67,6 @@ struct LaneElement {
   std::vector<LaneMeasurement> history;
   std::size_t first_frame = 0, last_frame = 0;
   double first_seen = 0.0, last_seen = 0.0;
-  std::size_t history_at_last_refit = 0;
   bool optimized = false;  // control points refined by a lane residual
 };
 

@@ -1,0 +1,48 @@
+// Growing a lane's spline as the vehicle drives: the ends of the control-point estimator g
+// ("extend the ends as new points arrive", DESIGN.md §4). g (spline_fitting.h) starts a lane
+// from one observation; every later frame hands the points of the lane's recent
+// observations to FitLaneEnds, which
+//  1. extends an end by whole chord spacings when enough points lie beyond it (along the
+//     end tangent, within max_point_distance_m of its line), new control points placed
+//     straight ahead;
+//  2. re-estimates, by robust linear least squares, the real control points of the segments
+//     the points fall on; the rest of the lane is held exactly.
+// Step 2, with the points' curve parameters u_i (closest points) held fixed, is linear in
+// the control points: each point gives p(u_i) = sum_j b_j(u_i) c_(s_i + j) (the Catmull-Rom
+// basis of catmull_rom_spline.h), the phantom ends are c_0 = 2 c_1 - c_2 and
+// c_(n-1) = 2 c_(n-2) - c_(n-3) (so the curve's end tangents follow the data), and
+//   min  sum_i w_i |p(u_i) - q_i|^2 + lambda sum_j |c_(j-1) - 2 c_j + c_(j+1)|^2
+//            + sum_j |c_j - c_j^prev|^2 / sigma^2
+// over the free points, with Huber weights w_i (re-weighted twice). x, y and z share the
+// same normal matrix (the basis is scalar), so it is one small m x m solve for 3 right-hand
+// sides. The second differences keep the control points evenly spaced along the curve and
+// bridge the gaps of dashed lines; the prior holds points that few samples reach.
+#pragma once
+
+#include <Eigen/Core>
+#include <vector>
+
+namespace ipm_road_mapper {
+
+// Parameters of FitLaneEnds (config section `lanes`; chord spacing is g's).
+struct LaneEndFitOptions {
+  double chord_spacing_m = 3.0;       // spacing of new control points (g's chord spacing)
+  int min_points_to_extend = 5;       // points beyond an end needed to grow it
+  double max_point_distance_m = 1.5;  // points farther from the curve (or end line) are ignored
+  double smoothness_weight = 1.0;     // lambda, per second difference (m^-2 relative to a point)
+  double prior_sigma_m = 1.0;         // pull of each free control point to its current value
+  double robust_scale_m = 0.3;        // Huber scale of the point residuals
+};
+
+// Extends and refines a lane's control points (phantom ends included, >= 4) with `points`
+// (map frame, the lane's recent observations). Returns the new control points; control
+// points that no point reaches are returned bit for bit, in place, and new ones are only
+// appended at the ends, so an interior control point keeps its index relative to the old
+// first one shifted by *added_at_start (if given). Non-finite points are ignored. Throws
+// std::invalid_argument when control_points has fewer than 4 points.
+std::vector<Eigen::Vector3d> FitLaneEnds(const std::vector<Eigen::Vector3d>& control_points,
+                                         const std::vector<Eigen::Vector3d>& points,
+                                         const LaneEndFitOptions& options,
+                                         int* added_at_start = nullptr);
+
+}  // namespace ipm_road_mapper
