@@ -13,8 +13,8 @@ namespace ipm_road_mapper {
 namespace extraction {
 namespace {
 
-// minAreaRect works in float: ground points go in as millimeters so that float rounding
-// (~1e-3 mm at 50 m) is far below the pixel footprint.
+// minAreaRect works in float: ground points go in as millimeters (relative to the outline's
+// first point) so that float rounding is far below the pixel footprint.
 constexpr double kMetersToMm = 1000.0;
 
 // Offsets from a pixel center to the midpoints of its four edges.
@@ -189,6 +189,23 @@ std::vector<Eigen::Vector2d> SubpixelOutline(const std::vector<cv::Point>& cente
 
 }  // namespace
 
+std::array<Eigen::Vector2d, 4> BoundingRectangle(const std::vector<Eigen::Vector2d>& outline,
+                                                 const Eigen::Vector2d& axis_in) {
+  const Eigen::Vector2d axis = axis_in.normalized();
+  const Eigen::Vector2d across(-axis.y(), axis.x());
+  const Eigen::Vector2d origin = outline.front();
+  double a_min = 1e18, a_max = -1e18, c_min = 1e18, c_max = -1e18;
+  for (const Eigen::Vector2d& p : outline) {
+    const Eigen::Vector2d d = p - origin;
+    a_min = std::min(a_min, d.dot(axis));
+    a_max = std::max(a_max, d.dot(axis));
+    c_min = std::min(c_min, d.dot(across));
+    c_max = std::max(c_max, d.dot(across));
+  }
+  return {origin + a_min * axis + c_min * across, origin + a_max * axis + c_min * across,
+          origin + a_max * axis + c_max * across, origin + a_min * axis + c_max * across};
+}
+
 void OrderCornersCanonically(std::array<Eigen::Vector3d, 4>* corners_base) {
   std::array<Eigen::Vector3d, 4>& c = *corners_base;
   double twice_area = 0.0;
@@ -208,54 +225,38 @@ void OrderCornersCanonically(std::array<Eigen::Vector3d, 4>* corners_base) {
 GeometryOutcome ExtractMarking(const Run* runs, int run_count, const Ipm& ipm,
                                const IpmErrorModel& error_model, const ExtractionOptions& options,
                                MarkingObservation* marking) {
-  const std::vector<Eigen::Vector2d> outline_uv =
-      SubpixelOutline(RowEnds(runs, SignificantPieces(runs, run_count)));
-  std::vector<cv::Point2f> outline_mm;
-  outline_mm.reserve(outline_uv.size());
-  for (const Eigen::Vector2d& uv : outline_uv) {
+  marking->outline_uv = SubpixelOutline(RowEnds(runs, SignificantPieces(runs, run_count)));
+  marking->outline_base.clear();
+  marking->outline_base.reserve(marking->outline_uv.size());
+  for (const Eigen::Vector2d& uv : marking->outline_uv) {
     Eigen::Vector3d p_base;
     // A point that does not map means the outline is cut by the horizon or the IPM range:
     // the rectangle would be truncated, as at the image border.
     if (ipm.PixelToGround(uv, &p_base) != IpmStatus::kOk) return GeometryOutcome::kRange;
-    outline_mm.emplace_back(static_cast<float>(p_base.x() * kMetersToMm),
-                            static_cast<float>(p_base.y() * kMetersToMm));
+    marking->outline_base.push_back(p_base.head<2>());
   }
-  const cv::RotatedRect rect_mm = cv::minAreaRect(outline_mm);
-  const double center_range_m = std::hypot(rect_mm.center.x, rect_mm.center.y) / kMetersToMm;
-  if (center_range_m > options.max_marking_range_m) return GeometryOutcome::kRange;
-  if (std::min(rect_mm.size.width, rect_mm.size.height) / kMetersToMm <
+  // Along the vehicle's heading until the mapper knows the road's (SetMarkingRectangle).
+  const std::array<Eigen::Vector2d, 4> rectangle =
+      BoundingRectangle(marking->outline_base, Eigen::Vector2d::UnitX());
+  const Eigen::Vector2d center = 0.25 * (rectangle[0] + rectangle[1] + rectangle[2] + rectangle[3]);
+  if (center.norm() > options.max_marking_range_m) return GeometryOutcome::kRange;
+  if (std::min((rectangle[1] - rectangle[0]).norm(), (rectangle[2] - rectangle[1]).norm()) <
       options.min_rectangle_side_m) {
     return GeometryOutcome::kDegenerate;
   }
-  cv::Point2f corners_mm[4];
-  rect_mm.points(corners_mm);
-  for (int i = 0; i < 4; ++i) {
-    marking->corners_base[i] =
-        Eigen::Vector3d(corners_mm[i].x / kMetersToMm, corners_mm[i].y / kMetersToMm, 0.0);
-  }
-  OrderCornersCanonically(&marking->corners_base);
-  for (int i = 0; i < 4; ++i) {
-    if (!ipm.BaseToPixel(marking->corners_base[i], &marking->corners_uv[i])) {
-      return GeometryOutcome::kRange;
-    }
-  }
-  marking->center_base = 0.25 * (marking->corners_base[0] + marking->corners_base[1] +
-                                 marking->corners_base[2] + marking->corners_base[3]);
-  Eigen::Vector2d center_uv;
-  if (!ipm.BaseToPixel(marking->center_base, &center_uv)) return GeometryOutcome::kRange;
-  const std::optional<IpmUncertainty> uncertainty =
-      ComputeIpmUncertainty(ipm.camera(), ipm.T_base_cam(), center_uv, error_model);
-  if (!uncertainty) return GeometryOutcome::kRange;
-  marking->center_cov_base = uncertainty->omega.topLeftCorner<2, 2>();
-  return GeometryOutcome::kOk;
+  return SetMarkingRectangle(ipm, error_model, Eigen::Vector2d::UnitX(), marking)
+             ? GeometryOutcome::kOk
+             : GeometryOutcome::kRange;
 }
-
 GeometryOutcome ExtractLane(const Run* runs, int run_count, const Ipm& ipm,
                             const IpmErrorModel& error_model, const ExtractionOptions& options,
                             LaneObservation* lane) {
   if (run_count <= 0) return GeometryOutcome::kDegenerate;
   const int row_step = std::max(options.lane_row_step, 1);
   const int bottom_row = runs[run_count - 1].row;
+  // A run cut by the image's side is not centered on the line: its center is no measurement.
+  const int margin = std::max(options.border_margin_px, 0);
+  const int last_col = ipm.camera().intrinsics().width - 1 - margin;
   // Rows bottom (near) first; within a row, runs left to right.
   int end = run_count;
   while (end > 0) {
@@ -264,6 +265,7 @@ GeometryOutcome ExtractLane(const Run* runs, int run_count, const Ipm& ipm,
     while (begin > 0 && runs[begin - 1].row == row) --begin;
     if ((bottom_row - row) % row_step == 0) {
       for (int i = begin; i < end; ++i) {
+        if (runs[i].first_col < margin || runs[i].last_col > last_col) continue;
         const Eigen::Vector2d uv(0.5 * (runs[i].first_col + runs[i].last_col), row);
         LanePoint point;
         if (ipm.PixelToGround(uv, &point.p_base) != IpmStatus::kOk) continue;
@@ -285,4 +287,27 @@ GeometryOutcome ExtractLane(const Run* runs, int run_count, const Ipm& ipm,
 }
 
 }  // namespace extraction
+
+bool SetMarkingRectangle(const Ipm& ipm, const IpmErrorModel& error_model,
+                         const Eigen::Vector2d& axis_base, MarkingObservation* marking) {
+  if (marking->outline_base.empty() || !(axis_base.norm() > 0.0)) return false;
+  const std::array<Eigen::Vector2d, 4> rectangle =
+      extraction::BoundingRectangle(marking->outline_base, axis_base);
+  for (int i = 0; i < 4; ++i) {
+    marking->corners_base[i] = Eigen::Vector3d(rectangle[i].x(), rectangle[i].y(), 0.0);
+  }
+  extraction::OrderCornersCanonically(&marking->corners_base);
+  for (int i = 0; i < 4; ++i) {
+    if (!ipm.BaseToPixel(marking->corners_base[i], &marking->corners_uv[i])) return false;
+  }
+  marking->center_base = 0.25 * (marking->corners_base[0] + marking->corners_base[1] +
+                                 marking->corners_base[2] + marking->corners_base[3]);
+  Eigen::Vector2d center_uv;
+  if (!ipm.BaseToPixel(marking->center_base, &center_uv)) return false;
+  const std::optional<IpmUncertainty> uncertainty =
+      ComputeIpmUncertainty(ipm.camera(), ipm.T_base_cam(), center_uv, error_model);
+  if (!uncertainty) return false;
+  marking->center_cov_base = uncertainty->omega.topLeftCorner<2, 2>();
+  return true;
+}
 }  // namespace ipm_road_mapper

@@ -54,19 +54,25 @@ enum class GeometryOutcome { kOk, kRange, kDegenerate };
 // convex outline of the instance's significant 8-connected pieces (all glyphs of a text
 // marking; specks below a tenth of the largest piece are debris). All of its points are
 // mapped to the ground (any failure: kRange, the marking is cut by the horizon or
-// the IPM range), then the minimum-area rectangle is taken and ordered canonically.
+// the IPM range), then the rectangle along base_link's x axis is set (SetMarkingRectangle).
 // The rectangle's center also gets the x-y block of Omega_p at its pixel (center_cov_base).
 GeometryOutcome ExtractMarking(const Run* runs, int run_count, const Ipm& ipm,
                                const IpmErrorModel& error_model, const ExtractionOptions& options,
                                MarkingObservation* marking);
 
 // Lane centerline points from the runs of one instance (row-major): every
-// options.lane_row_step rows from the bottom row up, the center of each run of that row,
+// options.lane_row_step rows from the bottom row up, the center of each run of that row
+// (runs within border_margin_px of the image's left or right side are cut: skipped),
 // mapped to the ground with its IPM uncertainty. kDegenerate when fewer than
 // options.min_lane_points survive the IPM.
 GeometryOutcome ExtractLane(const Run* runs, int run_count, const Ipm& ipm,
                             const IpmErrorModel& error_model, const ExtractionOptions& options,
                             LaneObservation* lane);
+
+// The rectangle with sides along `axis` (and across it) spanning `outline`,
+// counter-clockwise. `outline` must have at least one point, `axis` must not be zero.
+std::array<Eigen::Vector2d, 4> BoundingRectangle(const std::vector<Eigen::Vector2d>& outline,
+                                                 const Eigen::Vector2d& axis);
 
 // Reorders ground corners canonically: first the corner nearest base_link's origin, then
 // counter-clockwise seen from above (positive signed area in x-y).

@@ -11,6 +11,7 @@
 #include <vector>
 
 #include "ipm_road_mapper/core/instance_extraction.h"
+#include "../../src/core/instance_extraction_runs.h"  // BoundingRectangle
 #include "mask_test_utils.h"
 
 namespace ipm_road_mapper {
@@ -96,7 +97,10 @@ TEST_F(InstanceExtractionTest, MarkingCornersMatchTruthInCanonicalOrder) {
   ASSERT_EQ(obs.markings.size(), 1u);
   EXPECT_TRUE(obs.lanes.empty());
   EXPECT_EQ(obs.counters.instances_seen, 1u);
-  const MarkingObservation& m = obs.markings[0];
+  // Re-oriented along the road's direction (the mapper's part; 20 deg here).
+  MarkingObservation m = obs.markings[0];
+  ASSERT_TRUE(SetMarkingRectangle(ipm_, error_model_,
+                                  Eigen::Vector2d(std::cos(20 * kDeg), std::sin(20 * kDeg)), &m));
   EXPECT_EQ(m.class_id, 10);
   EXPECT_EQ(m.instance_value, kArrow + 3);
   EXPECT_GT(m.pixel_count, 500);
@@ -131,8 +135,10 @@ TEST_F(InstanceExtractionTest, MarkingCornersAccurateOverPosesAndYaws) {
   for (const Eigen::Vector2d& center :
        {Eigen::Vector2d(7.0, -1.5), Eigen::Vector2d(10.0, 0.4), Eigen::Vector2d(14.0, 2.0)}) {
     for (double yaw_deg : {0.0, 10.0, 20.0, 45.0, 70.0, 90.0, -30.0}) {
-      const FrameObservations obs = ExtractRectangle(center, 2.0, 0.5, yaw_deg * kDeg, kArrow);
+      FrameObservations obs = ExtractRectangle(center, 2.0, 0.5, yaw_deg * kDeg, kArrow);
       ASSERT_EQ(obs.markings.size(), 1u) << center.transpose() << " yaw " << yaw_deg;
+      const Eigen::Vector2d axis(std::cos(yaw_deg * kDeg), std::sin(yaw_deg * kDeg));
+      ASSERT_TRUE(SetMarkingRectangle(ipm_, error_model_, axis, &obs.markings[0]));
       const double error =
           MaxCornerError(obs.markings[0], GroundRectangle(center, 2.0, 0.5, yaw_deg * kDeg));
       EXPECT_LT(error, 0.06) << center.transpose() << " yaw " << yaw_deg;
@@ -189,6 +195,53 @@ TEST_F(InstanceExtractionTest, ThinRectangleIsDegenerate) {
   const FrameObservations obs = ExtractRectangle({10.0, 0.0}, 2.0, 0.5, 0.0, kStopLine);
   EXPECT_TRUE(obs.markings.empty());
   EXPECT_EQ(obs.counters.dropped_degenerate, 1u);
+}
+
+TEST(BoundingRectangle, SpansTheOutlineAlongTheGivenAxis) {
+  // A straight arrow 5 m long (shaft 0.3 m wide, head 1.2 m wide) turned by 30 deg: along
+  // its axis, its bounding rectangle is 5 x 1.2 m. (The minimum-area rectangle of this hull
+  // lies along a slanted edge of the head, 0.3-0.4 m off at the corners.)
+  const std::vector<Eigen::Vector2d> arrow_local = {
+      {0.0, -0.15}, {3.5, -0.15}, {3.5, -0.6}, {5.0, 0.0}, {3.5, 0.6}, {3.5, 0.15}, {0.0, 0.15}};
+  const double yaw = 30.0 * M_PI / 180.0;
+  const Eigen::Rotation2Dd R(yaw);
+  const Eigen::Vector2d offset(12.0, -2.0);
+  std::vector<Eigen::Vector2d> hull;  // the convex hull, as the outline is
+  for (int i : {0, 1, 2, 3, 4, 6}) hull.push_back(offset + R * arrow_local[i]);
+  const auto rect =
+      extraction::BoundingRectangle(hull, 2.0 * Eigen::Vector2d(std::cos(yaw), std::sin(yaw)));
+  const std::array<Eigen::Vector2d, 4> expected = {
+      offset + R * Eigen::Vector2d(0.0, -0.6), offset + R * Eigen::Vector2d(5.0, -0.6),
+      offset + R * Eigen::Vector2d(5.0, 0.6), offset + R * Eigen::Vector2d(0.0, 0.6)};
+  for (int i = 0; i < 4; ++i) EXPECT_LT((rect[i] - expected[i]).norm(), 1e-9) << i;
+  // Along x instead: the axis-aligned box of the hull.
+  const auto box = extraction::BoundingRectangle(hull, Eigen::Vector2d::UnitX());
+  double x_min = 1e9, x_max = -1e9;
+  for (const auto& p : hull) x_min = std::min(x_min, p.x()), x_max = std::max(x_max, p.x());
+  EXPECT_NEAR(box[0].x(), x_min, 1e-9);
+  EXPECT_NEAR(box[1].x(), x_max, 1e-9);
+}
+
+TEST_F(InstanceExtractionTest, SetMarkingRectangleReorientsAlongTheRoad) {
+  // A 3 x 0.8 m marking turned by 10 deg (a curve ahead): extracted along base_link's x it
+  // is the larger axis-aligned box; re-oriented along the road it is the marking itself.
+  cv::Mat mask = EmptyMask();
+  const double yaw = 10.0 * M_PI / 180.0;
+  RenderGroundRectangle(ipm_, {12.0, 1.2}, 3.0, 0.8, yaw, kArrow, &mask);
+  FrameObservations obs = Extract(mask);
+  ASSERT_EQ(obs.markings.size(), 1u);
+  const auto truth = GroundRectangle({12.0, 1.2}, 3.0, 0.8, yaw);
+  EXPECT_GT(MaxCornerError(obs.markings[0], truth), 0.1);
+  ASSERT_TRUE(SetMarkingRectangle(ipm_, IpmErrorModel(),
+                                  Eigen::Vector2d(std::cos(yaw), std::sin(yaw)),
+                                  &obs.markings[0]));
+  EXPECT_LT(MaxCornerError(obs.markings[0], truth), 0.06);  // a pixel is ~0.1 m deep at 12 m
+  // The pixel corners follow.
+  for (int i = 0; i < 4; ++i) {
+    Eigen::Vector2d uv;
+    ASSERT_TRUE(ipm_.BaseToPixel(obs.markings[0].corners_base[i], &uv));
+    EXPECT_LT((uv - obs.markings[0].corners_uv[i]).norm(), 1e-9);
+  }
 }
 
 TEST_F(InstanceExtractionTest, MarkingRectangleSpansAllItsGlyphs) {

@@ -32,13 +32,23 @@ ExtractionOptions LoadExtractionOptions(OptionsReader reader);
 // otherwise the reason (e.g. "mask is 640x480, camera is 1280x720").
 std::string ValidateMask(const cv::Mat& mask, int expected_width, int expected_height);
 
+// Sets the marking's rectangle from its outline with sides along `axis_base` (the road's
+// direction in base_link, x-y): corners on the ground in canonical order, their pixels, the
+// center and its Omega_p. The minimum-area rectangle is no substitute: for an arrow it can
+// lie along a slanted edge of the head, 0.3-0.4 m off at the corners and inconsistent from
+// frame to frame. False when a corner does not project.
+bool SetMarkingRectangle(const Ipm& ipm, const IpmErrorModel& error_model,
+                         const Eigen::Vector2d& axis_base, MarkingObservation* marking);
+
+
 // Extracts every instance of `mask` (which must pass ValidateMask; an unusable mask gives
 // nothing). One scan groups the pixels by value; unknown classes, tiny instances and markings
 // within border_margin_px of the border are dropped from its statistics; of the rest the
 // max_instances_per_frame largest are processed. Markings: sub-pixel outline of the
 // significant 8-connected pieces (every glyph of a text; specks under a tenth of the largest
-// piece are left out) -> IPM (any outline point failing: dropped_range) -> minimum-area
-// rectangle on the ground -> canonical corners, projected back for the pixel measurements.
+// piece are left out) -> IPM (any outline point failing: dropped_range) -> the rectangle
+// along base_link's x axis (SetMarkingRectangle) -> canonical corners, projected back for
+// the pixel measurements.
 // Lanes: every lane_row_step rows from the bottom, the center column of each run of the
 // instance's pixels in that row -> IPM point + uncertainty score. Results sorted by value.
 FrameObservations ExtractObservations(const cv::Mat& mask, const ClassTable& classes,

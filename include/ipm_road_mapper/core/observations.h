@@ -16,11 +16,17 @@ namespace ipm_road_mapper {
 struct MarkingObservation {
   int class_id = 0;
   int instance_value = 0;  // the mask pixel value, class_id * 1000 + instance_index
-  // Corners of the minimum-area rectangle on the ground, canonical order: starting at the
-  // corner nearest base_link's origin, counter-clockwise seen from above.
+  // Corners of the marking's bounding rectangle on the ground, its sides along the road
+  // (the rectangle of the ground truth): along base_link's x axis when extracted, along the
+  // mapped lanes once the mapper re-orients it. Canonical order: starting at the corner
+  // nearest base_link's origin, counter-clockwise seen from above.
   std::array<Eigen::Vector3d, 4> corners_base;
   // The same corners projected back into the image: the pixel measurements z_k.
   std::array<Eigen::Vector2d, 4> corners_uv;
+  // The instance's convex outline in the image (sub-pixel) and on the ground (x-y in
+  // base_link, its IPM), what the rectangle is fitted to.
+  std::vector<Eigen::Vector2d> outline_uv;
+  std::vector<Eigen::Vector2d> outline_base;
   // Center of the rectangle (mean of corners_base) and the x-y block of Omega_p at its
   // pixel: how far plain IPM may have put it (m^2), for the association gate.
   Eigen::Vector3d center_base = Eigen::Vector3d::Zero();

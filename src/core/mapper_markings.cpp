@@ -1,0 +1,110 @@
+// The marking half of the Mapper's front end: rectangles along the road, association, new
+// elements, and the plain-IPM estimate (the running mean of the observed corners) until the
+// back end owns a marking.
+#include <algorithm>
+#include <cmath>
+
+#include "ipm_road_mapper/core/association.h"
+#include "ipm_road_mapper/core/catmull_rom_spline.h"
+#include "ipm_road_mapper/core/instance_extraction.h"
+#include "ipm_road_mapper/core/mapper.h"
+
+namespace ipm_road_mapper {
+namespace {
+
+// A lane farther than this from a marking does not give it the road's direction.
+constexpr double kRoadAxisMaxDistanceM = 8.0;
+// Below this angle (rad) from base_link's x axis the extracted rectangle is kept.
+constexpr double kRoadAxisMinAngleRad = 1e-3;
+
+}  // namespace
+
+Eigen::Vector3d Mapper::RoadDirectionAt(const Eigen::Vector3d& p_map) const {
+  double best = kRoadAxisMaxDistanceM;
+  Eigen::Vector3d tangent_map = Eigen::Vector3d::Zero();
+  for (const LaneElement& lane : map_.lanes) {
+    if (lane.control_points_map.size() < 4) continue;
+    const CatmullRomSpline spline(lane.control_points_map);
+    const CatmullRomSpline::ClosestPoint closest = spline.FindClosest(p_map);
+    if (closest.distance_m >= best) continue;
+    best = closest.distance_m;
+    tangent_map = spline.Derivative(closest.s);
+  }
+  return tangent_map.norm() > 0.0 ? tangent_map.normalized() : tangent_map;
+}
+
+void Mapper::OrientMarkingsAlongRoad(const Ipm& ipm, const FrameRecord& frame,
+                                     std::vector<MarkingObservation>* markings) {
+  if (map_.lanes.empty()) return;
+  const Eigen::Isometry3d T_base_map = frame.T_map_base.inverse();
+  for (auto it = markings->begin(); it != markings->end();) {
+    const Eigen::Vector3d tangent_map = RoadDirectionAt(frame.T_map_base * it->center_base);
+    Eigen::Vector2d axis_base = (T_base_map.linear() * tangent_map).head<2>();
+    if (axis_base.norm() < 1e-9 ||
+        std::abs(std::atan2(axis_base.y(), axis_base.x())) < kRoadAxisMinAngleRad) {
+      ++it;
+      continue;
+    }
+    if (axis_base.x() < 0.0) axis_base = -axis_base;  // a rectangle has no direction
+    if (SetMarkingRectangle(ipm, options_.ipm.error_model, axis_base, &*it)) {
+      ++it;
+    } else {
+      it = markings->erase(it);  // its re-oriented corner leaves the image: not usable
+      ++counters_.extraction.dropped_range;
+    }
+  }
+}
+
+void Mapper::AddMarkings(const FrameObservations& observations, const FrameRecord& frame) {
+  std::vector<MarkingCandidate> candidates;
+  candidates.reserve(observations.markings.size());
+  for (const MarkingObservation& obs : observations.markings) {
+    MarkingCandidate candidate;
+    candidate.class_id = obs.class_id;
+    for (int i = 0; i < 4; ++i) candidate.corners_map[i] = frame.T_map_base * obs.corners_base[i];
+    const Eigen::Matrix2d R = frame.T_map_base.linear().topLeftCorner<2, 2>();
+    candidate.center_cov_map = R * obs.center_cov_base * R.transpose();
+    candidates.push_back(candidate);
+  }
+  const std::vector<int> match = AssociateMarkings(map_.markings, candidates, options_.association);
+  for (std::size_t c = 0; c < candidates.size(); ++c) {
+    const MarkingObservation& obs = observations.markings[c];
+    if (match[c] < 0) {
+      MarkingElement element;
+      element.id = map_.next_id++;
+      element.class_id = obs.class_id;
+      element.corners_map = candidates[c].corners_map;
+      element.center_cov_map = candidates[c].center_cov_map;
+      element.history.push_back({frame.index, obs.corners_uv, obs.corners_base, obs.outline_uv});
+      element.first_frame = element.last_frame = frame.index;
+      element.first_seen = element.last_seen = frame.stamp;
+      map_.markings.push_back(std::move(element));
+      ++counters_.markings_created;
+      continue;
+    }
+    MarkingElement& element = map_.markings[match[c]];
+    const int shift = BestCyclicShift(element.corners_map, candidates[c].corners_map, nullptr);
+    MarkingMeasurement measurement;
+    measurement.frame_index = frame.index;
+    for (int i = 0; i < 4; ++i) {
+      measurement.corners_uv[i] = obs.corners_uv[(i + shift) % 4];
+      measurement.corners_base[i] = obs.corners_base[(i + shift) % 4];
+    }
+    measurement.outline_uv = obs.outline_uv;
+    element.history.push_back(measurement);
+    element.last_frame = frame.index;
+    element.last_seen = frame.stamp;
+    if (candidates[c].center_cov_map.trace() < element.center_cov_map.trace()) {
+      element.center_cov_map = candidates[c].center_cov_map;
+    }
+    if (element.optimized) continue;  // the back end owns the estimate
+    // Plain IPM estimate: the running mean of the observed corners in the map.
+    const double n = static_cast<double>(element.history.size());
+    for (int i = 0; i < 4; ++i) {
+      element.corners_map[i] +=
+          (candidates[c].corners_map[(i + shift) % 4] - element.corners_map[i]) / n;
+    }
+  }
+}
+
+}  // namespace ipm_road_mapper
