@@ -228,6 +228,28 @@ TEST_F(ResidualTest, CornerReprojectionGradientCheck) {
   }
 }
 
+TEST_F(ResidualTest, CornerReprojectionStepBindingsMatchTheReference) {
+  const Eigen::Vector3d corner = GroundPoint(12.0, -1.5);
+  const Eigen::Vector2d uv = Project(corner) + Eigen::Vector2d(3.0, -2.0);
+  std::unique_ptr<ceres::CostFunction> full(CornerReprojectionResidual::Create(camera_, uv, 2.0));
+  const Eigen::VectorXd reference =
+      Evaluate(*full, {corner.data(), pose_.q.data(), pose_.t.data(), extrinsic_.q.data(),
+                       extrinsic_.t.data()});
+  std::unique_ptr<ceres::CostFunction> map_step(CornerReprojectionMapStepResidual::Create(
+      camera_, uv, 2.0, pose_.q.data(), pose_.t.data()));
+  const std::vector<const double*> map_blocks = {corner.data(), extrinsic_.q.data(),
+                                                 extrinsic_.t.data()};
+  EXPECT_LT((Evaluate(*map_step, map_blocks) - reference).norm(), 1e-12);
+  ExpectJacobiansMatch(*map_step, {nullptr, &kQuaternionManifold, nullptr}, map_blocks,
+                       kGradientPrecision);
+  std::unique_ptr<ceres::CostFunction> pose_step(CornerReprojectionPoseStepResidual::Create(
+      camera_, uv, 2.0, corner, extrinsic_.q.data(), extrinsic_.t.data()));
+  const std::vector<const double*> pose_blocks = {pose_.q.data(), pose_.t.data()};
+  EXPECT_LT((Evaluate(*pose_step, pose_blocks) - reference).norm(), 1e-12);
+  ExpectJacobiansMatch(*pose_step, {&kQuaternionManifold, nullptr}, pose_blocks,
+                       kGradientPrecision);
+}
+
 TEST_F(ResidualTest, CornerReprojectionIsZeroAtTheTrueProjection) {
   for (double x : {8.0, 15.0, 30.0}) {
     const Eigen::Vector3d corner = GroundPoint(x, -1.0);
@@ -308,6 +330,26 @@ TEST_F(PpsrTest, GradientCheck) {
                           extrinsic_.q.data(), extrinsic_.t.data()},
                          kGradientPrecision);
   }
+}
+
+// The step bindings compute the reference residual with some blocks held as data, and
+// their Jacobians (only the free blocks) pass the gradient check too.
+TEST_F(PpsrTest, StepBindingsMatchTheReferenceAndPassGradientChecks) {
+  const Eigen::Vector2d uv = a_ + 0.4 * (b_ - a_) + 3.0 * n_;
+  const Eigen::VectorXd reference = Residual(uv, 1.5);
+  std::unique_ptr<ceres::CostFunction> map_step(PpsrMapStepResidual::Create(
+      camera_, uv, 1.5, pose_.q.data(), pose_.t.data()));
+  const std::vector<const double*> map_blocks = {c1_.data(), c2_.data(), extrinsic_.q.data(),
+                                                 extrinsic_.t.data()};
+  EXPECT_LT((Evaluate(*map_step, map_blocks) - reference).norm(), 1e-12);
+  ExpectJacobiansMatch(*map_step, {nullptr, nullptr, &kQuaternionManifold, nullptr}, map_blocks,
+                       kGradientPrecision);
+  std::unique_ptr<ceres::CostFunction> pose_step(PpsrPoseStepResidual::Create(
+      camera_, uv, 1.5, c1_, c2_, extrinsic_.q.data(), extrinsic_.t.data()));
+  const std::vector<const double*> pose_blocks = {pose_.q.data(), pose_.t.data()};
+  EXPECT_LT((Evaluate(*pose_step, pose_blocks) - reference).norm(), 1e-12);
+  ExpectJacobiansMatch(*pose_step, {&kQuaternionManifold, nullptr}, pose_blocks,
+                       kGradientPrecision);
 }
 
 TEST_F(PpsrTest, IsZeroOnTheLineThroughTheProjectedControlPoints) {
