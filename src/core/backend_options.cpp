@@ -78,7 +78,10 @@ BackendOptions LoadBackendOptions(OptionsReader reader) {
   reader.Read<double>("max_extrinsic_change_m", &o.max_extrinsic_change_m, CheckPositive);
   reader.Read<int>("max_lane_points_per_observation", &o.max_lane_points_per_observation,
                    CheckPositiveInt);
-  reader.Read<double>("ground_height_sigma_m", &o.ground_height_sigma_m, CheckNonNegative);
+  reader.Read<double>("road_height_sigma_m", &o.road_height_sigma_m, CheckPositive);
+  reader.Read<double>("road_height_sigma_per_m", &o.road_height_sigma_per_m, CheckNonNegative);
+  reader.Read<double>("lane_anchor_along_sigma_m", &o.lane_anchor_along_sigma_m, CheckPositive);
+  reader.Read<double>("lane_anchor_across_sigma_m", &o.lane_anchor_across_sigma_m, CheckPositive);
   reader.RejectUnknownKeys();
   return o;
 }

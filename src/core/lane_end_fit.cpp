@@ -63,20 +63,27 @@ struct Dependence {
 
 std::vector<Eigen::Vector3d> FitLaneEnds(const std::vector<Eigen::Vector3d>& control_points,
                                          const std::vector<Eigen::Vector3d>& points,
-                                         const LaneEndFitOptions& options, int* added_at_start) {
+                                         const LaneEndFitOptions& options, int* added_at_start,
+                                         const std::vector<Eigen::Vector3d>* extension_points) {
   if (control_points.size() < 4) {
     throw std::invalid_argument("FitLaneEnds needs at least 4 control points");
   }
-  std::vector<Eigen::Vector3d> finite;
-  finite.reserve(points.size());
-  for (const Eigen::Vector3d& p : points) {
-    if (p.allFinite()) finite.push_back(p);
-  }
+  auto finite_of = [](const std::vector<Eigen::Vector3d>& in) {
+    std::vector<Eigen::Vector3d> out;
+    out.reserve(in.size());
+    for (const Eigen::Vector3d& p : in) {
+      if (p.allFinite()) out.push_back(p);
+    }
+    return out;
+  };
+  const std::vector<Eigen::Vector3d> finite = finite_of(points);
+  const std::vector<Eigen::Vector3d> growth =
+      extension_points ? finite_of(*extension_points) : finite;
   // 1. Grow both ends (the start by growing the reversed lane's end).
   std::vector<Eigen::Vector3d> cps = control_points;
-  ExtendEnd(options, finite, &cps);
+  ExtendEnd(options, growth, &cps);
   std::reverse(cps.begin(), cps.end());
-  const int at_start = ExtendEnd(options, finite, &cps);
+  const int at_start = ExtendEnd(options, growth, &cps);
   std::reverse(cps.begin(), cps.end());
   if (added_at_start) *added_at_start = at_start;
 
@@ -87,18 +94,25 @@ std::vector<Eigen::Vector3d> FitLaneEnds(const std::vector<Eigen::Vector3d>& con
     int segment;
     Eigen::Vector4d basis;
     Eigen::Vector3d point;
-    double weight;
+    double prior_weight;  // the point set's weight
+    double weight;        // times the Huber weight
   };
   std::vector<Sample> samples;
   std::vector<bool> free(n, false);
-  for (const Eigen::Vector3d& p : finite) {
-    const CatmullRomSpline::ClosestPoint closest = spline.FindClosest(p);
-    if (closest.distance_m > options.max_point_distance_m) continue;
-    const bool at_end = closest.s <= 0.0 || closest.s >= spline.NumSegments();
-    if (at_end && closest.distance_m > kEndSnapM) continue;
-    samples.push_back({closest.segment, Basis(closest.u), p, 1.0});
-    for (int j = 0; j < 4; ++j) free[closest.segment + j] = true;
-  }
+  auto add_samples = [&](const std::vector<Eigen::Vector3d>& set, double set_weight) {
+    for (const Eigen::Vector3d& p : set) {
+      const CatmullRomSpline::ClosestPoint closest = spline.FindClosest(p);
+      if (closest.distance_m > options.max_point_distance_m) continue;
+      const bool at_end = closest.s <= 0.0 || closest.s >= spline.NumSegments();
+      if (at_end && closest.distance_m > kEndSnapM) continue;
+      samples.push_back({closest.segment, Basis(closest.u), p, set_weight, set_weight});
+      for (int j = 0; j < 4; ++j) free[closest.segment + j] = true;
+    }
+  };
+  add_samples(finite, 1.0);
+  // The growth points shape the new control points too (nothing else reaches them yet),
+  // weakly, so that where `points` are they decide.
+  if (extension_points) add_samples(growth, options.extension_weight);
   free[0] = free[n - 1] = false;  // phantoms follow their neighbors (recomputed at the end)
   std::vector<int> unknown_of(n, -1);
   std::vector<int> point_of;
@@ -189,7 +203,7 @@ std::vector<Eigen::Vector3d> FitLaneEnds(const std::vector<Eigen::Vector3d>& con
         fit += s.basis(j) * c;
       }
       const double r = (fit - s.point).norm();
-      s.weight = r <= options.robust_scale_m ? 1.0 : options.robust_scale_m / r;
+      s.weight = s.prior_weight * (r <= options.robust_scale_m ? 1.0 : options.robust_scale_m / r);
     }
   }
   for (int k = 0; k < m; ++k) cps[point_of[k]] = x.row(k).transpose();

@@ -22,7 +22,9 @@ Mapper::Mapper(MapperOptions options, ClassTable classes,
     : options_(std::move(options)),
       classes_(std::move(classes)),
       T_base_cam_initial_(T_base_cam_initial),
-      T_base_cam_(T_base_cam_initial) {
+      T_base_cam_(T_base_cam_initial),
+      extrinsic_prior_(T_base_cam_initial, options_.backend.rotation_prior_sigma_rad,
+                       options_.backend.translation_prior_sigma_m) {
   if (options_.backend.enabled) backend_ = std::make_unique<Backend>(options_.backend);
 }
 
@@ -88,6 +90,7 @@ FrameStatus Mapper::ProcessFrame(const FrameInput& input, std::string* reason) {
   frame.T_map_base = input.T_map_base_odom;
   map_.frames.push_back(frame);
 
+  OrientMarkingsAlongRoad(ipm, frame, &observations.markings);
   AddMarkings(observations, frame);
   AddLanes(observations, frame);
   DropSpurious(frame.index);
@@ -96,57 +99,6 @@ FrameStatus Mapper::ProcessFrame(const FrameInput& input, std::string* reason) {
     backend_->Submit(BuildSnapshot());
   }
   return FrameStatus::kUsed;
-}
-
-void Mapper::AddMarkings(const FrameObservations& observations, const FrameRecord& frame) {
-  std::vector<MarkingCandidate> candidates;
-  candidates.reserve(observations.markings.size());
-  for (const MarkingObservation& obs : observations.markings) {
-    MarkingCandidate candidate;
-    candidate.class_id = obs.class_id;
-    for (int i = 0; i < 4; ++i) candidate.corners_map[i] = frame.T_map_base * obs.corners_base[i];
-    const Eigen::Matrix2d R = frame.T_map_base.linear().topLeftCorner<2, 2>();
-    candidate.center_cov_map = R * obs.center_cov_base * R.transpose();
-    candidates.push_back(candidate);
-  }
-  const std::vector<int> match = AssociateMarkings(map_.markings, candidates, options_.association);
-  for (std::size_t c = 0; c < candidates.size(); ++c) {
-    const MarkingObservation& obs = observations.markings[c];
-    if (match[c] < 0) {
-      MarkingElement element;
-      element.id = map_.next_id++;
-      element.class_id = obs.class_id;
-      element.corners_map = candidates[c].corners_map;
-      element.center_cov_map = candidates[c].center_cov_map;
-      element.history.push_back({frame.index, obs.corners_uv, obs.corners_base});
-      element.first_frame = element.last_frame = frame.index;
-      element.first_seen = element.last_seen = frame.stamp;
-      map_.markings.push_back(std::move(element));
-      ++counters_.markings_created;
-      continue;
-    }
-    MarkingElement& element = map_.markings[match[c]];
-    const int shift = BestCyclicShift(element.corners_map, candidates[c].corners_map, nullptr);
-    MarkingMeasurement measurement;
-    measurement.frame_index = frame.index;
-    for (int i = 0; i < 4; ++i) {
-      measurement.corners_uv[i] = obs.corners_uv[(i + shift) % 4];
-      measurement.corners_base[i] = obs.corners_base[(i + shift) % 4];
-    }
-    element.history.push_back(measurement);
-    element.last_frame = frame.index;
-    element.last_seen = frame.stamp;
-    if (candidates[c].center_cov_map.trace() < element.center_cov_map.trace()) {
-      element.center_cov_map = candidates[c].center_cov_map;
-    }
-    if (element.optimized) continue;  // the back end owns the estimate
-    // Plain IPM estimate: the running mean of the observed corners in the map.
-    const double n = static_cast<double>(element.history.size());
-    for (int i = 0; i < 4; ++i) {
-      element.corners_map[i] +=
-          (candidates[c].corners_map[(i + shift) % 4] - element.corners_map[i]) / n;
-    }
-  }
 }
 
 void Mapper::DropSpurious(std::size_t frame_index) {
@@ -169,6 +121,7 @@ void Mapper::Reset() {
   }
   map_ = RoadMap();
   last_stamp_ = -1.0;
+  // The extrinsic and what is known about it belong to the vehicle, not to the map: kept.
 }
 
 void Mapper::Finish() {
@@ -176,84 +129,11 @@ void Mapper::Finish() {
   backend_->Submit(BuildSnapshot());
   backend_->WaitIdle();
   ApplyBackendResults();
+  RefineRetiredMarkings();
 }
 
-WindowSnapshot Mapper::BuildSnapshot() {
-  WindowSnapshot snapshot;
-  snapshot.sequence = next_sequence_++;
-  snapshot.camera = camera_;
-  snapshot.T_base_cam = T_base_cam_;
-  snapshot.t_base_cam_prior = T_base_cam_initial_.translation();
-  snapshot.q_base_cam_prior = Eigen::Quaterniond(T_base_cam_initial_.linear());
-  const std::size_t window = static_cast<std::size_t>(options_.backend.window_frames);
-  const std::size_t first = map_.frames.size() > window ? map_.frames.size() - window : 0;
-  for (std::size_t i = first; i < map_.frames.size(); ++i) {
-    const FrameRecord& f = map_.frames[i];
-    snapshot.frames.push_back({f.index, f.T_map_base, f.T_map_base_odom});
-  }
-  for (const MarkingElement& m : map_.markings) {
-    if (m.last_frame < first) continue;  // outside the window: held fixed
-    WindowMarking wm{m.id, m.corners_map, {}};
-    for (const MarkingMeasurement& meas : m.history) {
-      if (meas.frame_index >= first) wm.measurements.push_back(meas);
-    }
-    snapshot.markings.push_back(std::move(wm));
-  }
-  for (const LaneElement& l : map_.lanes) {
-    if (l.last_frame < first) continue;
-    WindowLane wl{l.id, l.first_cp_index, l.control_points_map, {}};
-    for (const LaneMeasurement& meas : l.history) {
-      if (meas.frame_index >= first) wl.measurements.push_back(meas);
-    }
-    snapshot.lanes.push_back(std::move(wl));
-  }
-  return snapshot;
-}
 
-void Mapper::ApplyBackendResults() {
-  if (!backend_) return;
-  for (const auto& result : backend_->TakeResults()) {
-    if (!result->usable) {
-      ++counters_.results_rejected;
-      continue;
-    }
-    ApplyResult(*result);
-    ++counters_.results_applied;
-  }
-}
 
-void Mapper::ApplyResult(const WindowResult& result) {
-  T_base_cam_ = result.T_base_cam;  // fed forward to the next frames' IPM
-  for (const WindowFrame& f : result.frames) {
-    if (f.index < map_.frames.size()) map_.frames[f.index].T_map_base = f.T_map_base;
-  }
-  if (options_.backend.optimize_markings) {
-    for (const WindowMarking& wm : result.markings) {
-      for (MarkingElement& m : map_.markings) {
-        if (m.id != wm.id) continue;
-        m.corners_map = wm.corners_map;
-        m.optimized = true;
-      }
-    }
-  }
-  if (!LanesRefinedByBackend()) return;
-  for (const WindowLane& wl : result.lanes) {
-    for (LaneElement& lane : map_.lanes) {
-      if (lane.id != wl.id) continue;
-      const std::int64_t offset = wl.first_cp_index - lane.first_cp_index;
-      const std::int64_t n_result = static_cast<std::int64_t>(wl.control_points_map.size());
-      const std::int64_t n_lane = static_cast<std::int64_t>(lane.control_points_map.size());
-      for (std::int64_t j = 0; j < n_result; ++j) {
-        const std::int64_t k = j + offset;
-        if (k < 0 || k >= n_lane) continue;
-        // A phantom end of the snapshot that has since become a real point: keep the new one.
-        if ((j == 0 && k != 0) || (j == n_result - 1 && k != n_lane - 1)) continue;
-        lane.control_points_map[k] = wl.control_points_map[j];
-      }
-      lane.optimized = true;
-    }
-  }
-}
 
 VectorMap Mapper::ExportMap() const {
   VectorMap out;

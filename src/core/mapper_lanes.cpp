@@ -77,14 +77,19 @@ void Mapper::AddLanes(const FrameObservations& observations, const FrameRecord& 
     lane.history.push_back(std::move(measurements[c]));
     lane.last_frame = frame.index;
     lane.last_seen = frame.stamp;
-    GrowLane(&lane, frame.index);
+    std::vector<Eigen::Vector3d> usable_map;
+    for (std::size_t i = 0; i < candidates[c].points_map.size(); ++i) {
+      if (candidates[c].usable[i]) usable_map.push_back(candidates[c].points_map[i]);
+    }
+    GrowLane(&lane, frame.index, usable_map);
   }
   if (map_.frames.size() % static_cast<std::size_t>(options_.lanes.merge_every_n_frames) == 0) {
     MergeLanes();
   }
 }
 
-void Mapper::GrowLane(LaneElement* lane, std::size_t frame_index) const {
+void Mapper::GrowLane(LaneElement* lane, std::size_t frame_index,
+                      const std::vector<Eigen::Vector3d>& usable_map) const {
   const std::size_t horizon = static_cast<std::size_t>(options_.lanes.end_fit_frames);
   std::vector<Eigen::Vector3d> points;
   for (auto m = lane->history.rbegin(); m != lane->history.rend(); ++m) {
@@ -92,8 +97,8 @@ void Mapper::GrowLane(LaneElement* lane, std::size_t frame_index) const {
     points.insert(points.end(), m->selected_map.begin(), m->selected_map.end());
   }
   int added_at_start = 0;
-  lane->control_points_map =
-      FitLaneEnds(lane->control_points_map, points, options_.lanes.end_fit, &added_at_start);
+  lane->control_points_map = FitLaneEnds(lane->control_points_map, points, options_.lanes.end_fit,
+                                         &added_at_start, &usable_map);
   lane->first_cp_index -= added_at_start;  // keeps older back-end results applicable
 }
 

@@ -2,29 +2,32 @@
 
 #include <ceres/ceres.h>
 
+#include <algorithm>
 #include <chrono>
+#include <cmath>
+#include <limits>
 #include <map>
-#include <memory>
 
 #include "ipm_road_mapper/core/catmull_rom_spline.h"
 #include "ipm_road_mapper/core/ipm.h"
-#include "ipm_road_mapper/core/rigid_transform.h"
+#include "ipm_road_mapper/core/marking_measurement.h"
+#include "ipm_road_mapper/core/residuals/along_lane_anchor_residual.h"
 #include "ipm_road_mapper/core/residuals/corner_reprojection_residual.h"
+#include "ipm_road_mapper/core/residuals/extrinsic_prior_residual.h"
 #include "ipm_road_mapper/core/residuals/ground_height_prior_residual.h"
-#include "ipm_road_mapper/core/residuals/point_anchor_residual.h"
 #include "ipm_road_mapper/core/residuals/pose_prior_residual.h"
 #include "ipm_road_mapper/core/residuals/ppsr_residual.h"
 #include "ipm_road_mapper/core/residuals/psr_residual.h"
-#include "ipm_road_mapper/core/residuals/rotation_prior_residual.h"
-#include "ipm_road_mapper/core/residuals/translation_prior_residual.h"
+#include "ipm_road_mapper/core/rigid_transform.h"
 
 namespace ipm_road_mapper {
 namespace {
 
-// Sigma of the along-lane anchor of each control point (see point_anchor_residual.h).
-constexpr double kControlPointAnchorSigmaM = 1.0;
 // Lane pixels whose IPM point is farther than this from the spline are not used.
 constexpr double kMaxLanePixelDistanceM = 1.5;
+// A measurement whose projection at the start of a solve is farther than this outside the
+// image is an outlier of association or a point behind the camera: it is not added.
+constexpr double kMaxOutsideImagePx = 100.0;
 
 // A rigid transform as Ceres parameter blocks: quaternion (x, y, z, w) and translation.
 struct PoseBlocks {
@@ -44,24 +47,34 @@ struct PoseBlocks {
   }
 };
 
-// One lane pixel's residual: which lane, frame and control points (global c0 index of the
-// segment, i.e. the segment's control points are c[i] .. c[i + 3]).
+// One marking corner measurement: which marking, corner and frame slot.
+struct CornerMeasurement {
+  std::size_t marking = 0;
+  int corner = 0;
+  std::size_t slot = 0;
+  Eigen::Vector2d uv;
+};
+
+// One lane pixel: which lane, frame slot and spline segment (the segment's control points
+// are c[segment] .. c[segment + 3]; PPSR uses c[segment + 1], c[segment + 2]).
 struct LanePixel {
   std::size_t lane = 0;
-  std::size_t frame_slot = 0;
+  std::size_t slot = 0;
   Eigen::Vector2d uv;
   int segment = 0;
   double u = 0.0;
   Eigen::Vector3d q_map;  // IPM point at build time (PSR)
 };
 
-// The mutable state of one solve, initialized from the snapshot.
+// The mutable state of one solve, initialized from the snapshot, and the measurements that
+// survived the build-time checks.
 struct WindowState {
   PoseBlocks extrinsic;
   std::vector<PoseBlocks> frames;
   std::map<std::size_t, std::size_t> slot_of_frame;
   std::vector<std::array<Eigen::Vector3d, 4>> corners;
   std::vector<std::vector<Eigen::Vector3d>> control_points;
+  std::vector<CornerMeasurement> corner_measurements;
   std::vector<LanePixel> lane_pixels;
   explicit WindowState(const WindowSnapshot& s) : extrinsic(s.T_base_cam) {
     for (std::size_t i = 0; i < s.frames.size(); ++i) {
@@ -73,10 +86,73 @@ struct WindowState {
   }
 };
 
-// Assigns each used lane pixel to the spline segment its IPM point falls on.
-void AssignLanePixels(const WindowSnapshot& snapshot, const BackendOptions& options,
-                      WindowState* state) {
-  const Ipm ipm(PinholeCamera(snapshot.camera), snapshot.T_base_cam, 1e9);
+// True when p_map projects in front of the camera of `slot`, at most kMaxOutsideImagePx
+// outside the image.
+bool ProjectsNearImage(const PinholeCamera& camera, const WindowState& state, std::size_t slot,
+                       const Eigen::Vector3d& p_map) {
+  Eigen::Vector2d uv;
+  if (!residuals::ProjectMapPoint(camera, state.frames[slot].q, state.frames[slot].t,
+                                  state.extrinsic.q, state.extrinsic.t, p_map, &uv)) {
+    return false;
+  }
+  const double m = kMaxOutsideImagePx;
+  return uv.x() > -m && uv.y() > -m && uv.x() < camera.intrinsics().width + m &&
+         uv.y() < camera.intrinsics().height + m;
+}
+
+// The slot of the window frame horizontally closest to p_map.
+std::size_t ClosestSlot(const WindowState& state, const Eigen::Vector3d& p_map) {
+  double best = std::numeric_limits<double>::infinity();
+  std::size_t best_slot = 0;
+  for (std::size_t slot = 0; slot < state.frames.size(); ++slot) {
+    const double d =
+        (Eigen::Map<const Eigen::Vector3d>(state.frames[slot].t) - p_map).head<2>().squaredNorm();
+    if (d < best) {
+      best = d;
+      best_slot = slot;
+    }
+  }
+  return best_slot;
+}
+
+// Collects the corner measurements of the window's frames, each re-measured from its
+// outline on the road plane nearest to the marking: base_link's plane of the window frame
+// closest to it (see marking_measurement.h; the flat-ground corners are the fallback).
+void CollectCornerMeasurements(const WindowSnapshot& snapshot, WindowState* state) {
+  const PinholeCamera camera(snapshot.camera);
+  const Eigen::Isometry3d T_base_cam = state->extrinsic.ToIsometry();
+  for (std::size_t m = 0; m < snapshot.markings.size(); ++m) {
+    const auto& corners = state->corners[m];
+    const Eigen::Vector3d center = 0.25 * (corners[0] + corners[1] + corners[2] + corners[3]);
+    const Eigen::Isometry3d T_map_road = state->frames[ClosestSlot(*state, center)].ToIsometry();
+    const RoadPlane plane{T_map_road.translation(), T_map_road.linear().col(2)};
+    const Eigen::Vector3d& axis = snapshot.markings[m].axis_map;
+    for (const MarkingMeasurement& meas : snapshot.markings[m].measurements) {
+      const auto slot = state->slot_of_frame.find(meas.frame_index);
+      if (slot == state->slot_of_frame.end()) continue;
+      std::array<Eigen::Vector2d, 4> corners_uv = meas.corners_uv;
+      if (!meas.outline_uv.empty() && axis.norm() > 0.0) {
+        const Eigen::Isometry3d T_map_cam = state->frames[slot->second].ToIsometry() * T_base_cam;
+        std::array<Eigen::Vector2d, 4> on_plane;
+        if (MeasureCornersOnPlane(camera, T_map_cam, plane, axis, corners, meas.outline_uv,
+                                  &on_plane)) {
+          corners_uv = on_plane;
+        }
+      }
+      for (int c = 0; c < 4; ++c) {
+        if (!ProjectsNearImage(camera, *state, slot->second, corners[c])) continue;
+        state->corner_measurements.push_back({m, c, slot->second, corners_uv[c]});
+      }
+    }
+  }
+}
+
+// Assigns each selected lane pixel of the window to the spline segment its IPM point falls
+// on (at most max_lane_points_per_observation per observation, spread over its points).
+void CollectLanePixels(const WindowSnapshot& snapshot, const BackendOptions& options,
+                       WindowState* state) {
+  const PinholeCamera camera(snapshot.camera);
+  const Ipm ipm(camera, snapshot.T_base_cam, 1e9);
   for (std::size_t l = 0; l < snapshot.lanes.size(); ++l) {
     const WindowLane& lane = snapshot.lanes[l];
     if (lane.control_points_map.size() < 4) continue;
@@ -84,19 +160,28 @@ void AssignLanePixels(const WindowSnapshot& snapshot, const BackendOptions& opti
     for (const LaneMeasurement& m : lane.measurements) {
       const auto slot = state->slot_of_frame.find(m.frame_index);
       if (slot == state->slot_of_frame.end()) continue;
-      const Eigen::Isometry3d T_map_base = snapshot.frames[slot->second].T_map_base;
-      int used = 0;
+      std::vector<std::size_t> selected;
       for (std::size_t i = 0; i < m.points.size(); ++i) {
-        if (!m.selected[i] || used >= options.max_lane_points_per_observation) continue;
+        if (m.selected[i]) selected.push_back(i);
+      }
+      const std::size_t cap = static_cast<std::size_t>(options.max_lane_points_per_observation);
+      const double step = selected.size() > cap ? static_cast<double>(selected.size()) / cap : 1.0;
+      const Eigen::Isometry3d T_map_base = state->frames[slot->second].ToIsometry();
+      for (double k = 0.0; k < static_cast<double>(selected.size()); k += step) {
+        const LanePoint& point = m.points[selected[static_cast<std::size_t>(k)]];
         Eigen::Vector3d p_base;
-        if (ipm.PixelToGround(m.points[i].uv, &p_base) != IpmStatus::kOk) continue;
+        if (ipm.PixelToGround(point.uv, &p_base) != IpmStatus::kOk) continue;
         const Eigen::Vector3d p_map = T_map_base * p_base;
         const CatmullRomSpline::ClosestPoint closest = spline.FindClosest(p_map);
         if (closest.distance_m > kMaxLanePixelDistanceM) continue;
         if (closest.s <= 0.0 || closest.s >= spline.NumSegments()) continue;  // past an end
+        const auto& cps = lane.control_points_map;
+        if (!ProjectsNearImage(camera, *state, slot->second, cps[closest.segment + 1]) ||
+            !ProjectsNearImage(camera, *state, slot->second, cps[closest.segment + 2])) {
+          continue;
+        }
         state->lane_pixels.push_back(
-            {l, slot->second, m.points[i].uv, closest.segment, closest.u, p_map});
-        ++used;
+            {l, slot->second, point.uv, closest.segment, closest.u, p_map});
       }
     }
   }
@@ -108,62 +193,33 @@ ceres::LossFunction* MakeLoss(const BackendOptions& options) {
   return nullptr;
 }
 
-// Adds the measurement residuals shared by both steps (corner reprojection and the lane
-// residual). Returns the number of residual blocks added.
-int AddMeasurementResiduals(const WindowSnapshot& snapshot, const BackendOptions& options,
-                            WindowState* state, ceres::Problem* problem,
-                            ceres::LossFunction* loss) {
-  const PinholeCamera camera(snapshot.camera);
-  int blocks = 0;
-  double* q_bc = state->extrinsic.q;
-  double* t_bc = state->extrinsic.t;
-  for (std::size_t m = 0; m < snapshot.markings.size(); ++m) {
-    for (const MarkingMeasurement& meas : snapshot.markings[m].measurements) {
-      const auto slot = state->slot_of_frame.find(meas.frame_index);
-      if (slot == state->slot_of_frame.end()) continue;
-      PoseBlocks& pose = state->frames[slot->second];
-      for (int c = 0; c < 4; ++c) {
-        problem->AddResidualBlock(residuals::CornerReprojectionResidual::Create(
-                                      camera, meas.corners_uv[c], options.pixel_sigma_px),
-                                  loss, state->corners[m][c].data(), pose.q, pose.t, q_bc, t_bc);
-        ++blocks;
-      }
+// The road-surface prior of a map point (see ground_height_prior_residual.h): its height in
+// base_link of the window's frame horizontally closest to it, with a sigma that grows with
+// that distance (the road is known at the wheels, less so ahead of them).
+void AddRoadSurfacePrior(const BackendOptions& options, const WindowState& state, double* point,
+                         ceres::Problem* problem) {
+  const Eigen::Vector3d p(point[0], point[1], point[2]);
+  double best = 1e18;
+  std::size_t best_slot = 0;
+  for (std::size_t slot = 0; slot < state.frames.size(); ++slot) {
+    const double d =
+        (Eigen::Map<const Eigen::Vector3d>(state.frames[slot].t) - p).head<2>().squaredNorm();
+    if (d < best) {
+      best = d;
+      best_slot = slot;
     }
   }
-  for (const LanePixel& px : state->lane_pixels) {
-    auto& cps = state->control_points[px.lane];
-    PoseBlocks& pose = state->frames[px.frame_slot];
-    if (options.lane_residual == LaneResidual::kPpsr) {
-      problem->AddResidualBlock(
-          residuals::PpsrResidual::Create(camera, px.uv, options.pixel_sigma_px), loss,
-          cps[px.segment + 1].data(), cps[px.segment + 2].data(), pose.q, pose.t, q_bc, t_bc);
-      ++blocks;
-    } else if (options.lane_residual == LaneResidual::kPsr) {
-      problem->AddResidualBlock(residuals::PsrResidual::Create(px.q_map, px.u, options.psr_sigma_m),
-                                loss, cps[px.segment].data(), cps[px.segment + 1].data(),
-                                cps[px.segment + 2].data(), cps[px.segment + 3].data());
-      ++blocks;
-    }
-  }
-  return blocks;
+  const double distance = std::sqrt(best);
+  const double sigma = std::hypot(options.road_height_sigma_m,
+                                  options.road_height_sigma_per_m * distance);
+  problem->AddResidualBlock(residuals::GroundHeightPriorResidual::Create(
+                                state.frames[best_slot].ToIsometry(), sigma),
+                            nullptr, point);
 }
 
-// Marks each used 3D point block: constant, or free with z held when optimize_z is off.
-void ConfigurePointBlock(ceres::Problem* problem, double* point, bool free, bool optimize_z) {
-  if (!problem->HasParameterBlock(point)) return;
-  if (!free) {
-    problem->SetParameterBlockConstant(point);
-  } else if (!optimize_z) {
-    problem->SetManifold(point, new ceres::SubsetManifold(3, {2}));
-  }
-}
-
-void ConfigurePose(ceres::Problem* problem, PoseBlocks* pose, bool free) {
-  if (problem->HasParameterBlock(pose->q)) {
-    problem->SetManifold(pose->q, new ceres::EigenQuaternionManifold);
-    if (!free) problem->SetParameterBlockConstant(pose->q);
-  }
-  if (problem->HasParameterBlock(pose->t) && !free) problem->SetParameterBlockConstant(pose->t);
+// Free 3D map point: z held by a subset manifold when optimize_z is off.
+void ConfigurePoint(const BackendOptions& options, double* point, ceres::Problem* problem) {
+  if (!options.optimize_z) problem->SetManifold(point, new ceres::SubsetManifold(3, {2}));
 }
 
 ceres::Solver::Summary Solve(const BackendOptions& options, ceres::Problem* problem) {
@@ -177,106 +233,112 @@ ceres::Solver::Summary Solve(const BackendOptions& options, ceres::Problem* prob
   return summary;
 }
 
-// The pose (of the window's frames) from which `p_map` was seen closest, among `frames`.
-const Eigen::Isometry3d* ClosestFrame(const WindowSnapshot& snapshot,
-                                      const std::vector<std::size_t>& frame_indices,
-                                      const WindowState& state, const Eigen::Vector3d& p_map) {
-  const Eigen::Isometry3d* best = nullptr;
-  double best_distance = 1e18;
-  for (std::size_t index : frame_indices) {
-    const auto slot = state.slot_of_frame.find(index);
-    if (slot == state.slot_of_frame.end()) continue;
-    const Eigen::Isometry3d& T = snapshot.frames[slot->second].T_map_base;
-    const double d = (T.translation() - p_map).head<2>().norm();
-    if (d < best_distance) {
-      best_distance = d;
-      best = &T;
-    }
-  }
-  return best;
-}
-
-// Ground-height priors for every free map point (see ground_height_prior_residual.h).
-void AddGroundHeightPriors(const WindowSnapshot& snapshot, const BackendOptions& options,
-                           WindowState* state, ceres::Problem* problem) {
-  for (std::size_t m = 0; m < snapshot.markings.size() && options.optimize_markings; ++m) {
-    std::vector<std::size_t> frames;
-    for (const auto& meas : snapshot.markings[m].measurements) frames.push_back(meas.frame_index);
-    for (auto& c : state->corners[m]) {
-      if (!problem->HasParameterBlock(c.data())) continue;
-      if (const Eigen::Isometry3d* T = ClosestFrame(snapshot, frames, *state, c)) {
-        problem->AddResidualBlock(
-            residuals::GroundHeightPriorResidual::Create(*T, options.ground_height_sigma_m),
-            nullptr, c.data());
-      }
-    }
-  }
-  if (options.lane_residual == LaneResidual::kNone) return;
-  for (std::size_t l = 0; l < snapshot.lanes.size(); ++l) {
-    std::vector<std::size_t> frames;
-    for (const auto& meas : snapshot.lanes[l].measurements) frames.push_back(meas.frame_index);
-    for (auto& c : state->control_points[l]) {
-      if (!problem->HasParameterBlock(c.data())) continue;
-      if (const Eigen::Isometry3d* T = ClosestFrame(snapshot, frames, *state, c)) {
-        problem->AddResidualBlock(
-            residuals::GroundHeightPriorResidual::Create(*T, options.ground_height_sigma_m),
-            nullptr, c.data());
-      }
-    }
-  }
-}
-
-// The map + extrinsic step. Returns the summary.
+// The map + extrinsic step: marking corners, lane control points and the extrinsic free,
+// the window's poses data (which also fixes the gauge: the map hangs on the poses).
 ceres::Solver::Summary MapStep(const WindowSnapshot& snapshot, const BackendOptions& options,
                                WindowState* state, int* blocks) {
   ceres::Problem problem;
   ceres::LossFunction* loss = MakeLoss(options);
-  *blocks = AddMeasurementResiduals(snapshot, options, state, &problem, loss);
+  const PinholeCamera camera(snapshot.camera);
+  double* q_bc = state->extrinsic.q;
+  double* t_bc = state->extrinsic.t;
+  *blocks = 0;
+  if (options.optimize_markings) {
+    for (const CornerMeasurement& m : state->corner_measurements) {
+      const PoseBlocks& pose = state->frames[m.slot];
+      problem.AddResidualBlock(residuals::CornerReprojectionMapStepResidual::Create(
+                                   camera, m.uv, options.pixel_sigma_px, pose.q, pose.t),
+                               loss, state->corners[m.marking][m.corner].data(), q_bc, t_bc);
+      ++*blocks;
+    }
+  }
+  for (const LanePixel& px : state->lane_pixels) {
+    auto& cps = state->control_points[px.lane];
+    const PoseBlocks& pose = state->frames[px.slot];
+    if (options.lane_residual == LaneResidual::kPpsr) {
+      problem.AddResidualBlock(residuals::PpsrMapStepResidual::Create(
+                                   camera, px.uv, options.pixel_sigma_px, pose.q, pose.t),
+                               loss, cps[px.segment + 1].data(), cps[px.segment + 2].data(), q_bc,
+                               t_bc);
+      ++*blocks;
+    } else if (options.lane_residual == LaneResidual::kPsr) {
+      problem.AddResidualBlock(residuals::PsrResidual::Create(px.q_map, px.u, options.psr_sigma_m),
+                               loss, cps[px.segment].data(), cps[px.segment + 1].data(),
+                               cps[px.segment + 2].data(), cps[px.segment + 3].data());
+      ++*blocks;
+    }
+  }
   if (*blocks == 0) {
     delete loss;
     return ceres::Solver::Summary();
   }
-  problem.AddResidualBlock(residuals::TranslationPriorResidual::Create(
-                               snapshot.t_base_cam_prior, options.translation_prior_sigma_m),
-                           nullptr, state->extrinsic.t);
-  problem.AddResidualBlock(residuals::RotationPriorResidual::Create(
-                               snapshot.q_base_cam_prior, options.rotation_prior_sigma_rad),
-                           nullptr, state->extrinsic.q);
-  const bool lanes_free = options.lane_residual != LaneResidual::kNone;
-  for (auto& cps : state->control_points) {
-    for (auto& c : cps) {
-      if (!lanes_free || !problem.HasParameterBlock(c.data())) continue;
-      problem.AddResidualBlock(
-          residuals::PointAnchorResidual::Create(c, kControlPointAnchorSigmaM), nullptr, c.data());
-    }
-  }
-  if (options.ground_height_sigma_m > 0.0 && options.optimize_z) {
-    AddGroundHeightPriors(snapshot, options, state, &problem);
-  }
+  // Map points: on the road surface (softly), z optionally held; control points anchored
+  // along their lane (PPSR leaves that direction free: a gauge of each point).
   for (auto& corners : state->corners) {
     for (auto& c : corners) {
-      ConfigurePointBlock(&problem, c.data(), options.optimize_markings, options.optimize_z);
+      if (!problem.HasParameterBlock(c.data())) continue;
+      if (options.optimize_z) AddRoadSurfacePrior(options, *state, c.data(), &problem);
+      ConfigurePoint(options, c.data(), &problem);
     }
   }
   for (auto& cps : state->control_points) {
-    for (auto& c : cps) ConfigurePointBlock(&problem, c.data(), lanes_free, options.optimize_z);
+    for (std::size_t j = 0; j < cps.size(); ++j) {
+      auto& c = cps[j];
+      if (!problem.HasParameterBlock(c.data())) continue;
+      const Eigen::Vector3d tangent = cps[std::min(j + 1, cps.size() - 1)] - cps[j > 0 ? j - 1 : 0];
+      problem.AddResidualBlock(
+          residuals::AlongLaneAnchorResidual::Create(c, tangent, options.lane_anchor_along_sigma_m,
+                                                     options.lane_anchor_across_sigma_m),
+          nullptr, c.data());
+      if (options.optimize_z) AddRoadSurfacePrior(options, *state, c.data(), &problem);
+      ConfigurePoint(options, c.data(), &problem);
+    }
   }
-  for (PoseBlocks& pose : state->frames) ConfigurePose(&problem, &pose, false);
-  // The extrinsic: rotation on the quaternion manifold; held when not optimized.
-  problem.SetManifold(state->extrinsic.q, new ceres::EigenQuaternionManifold);
-  if (!options.optimize_extrinsic) {
-    problem.SetParameterBlockConstant(state->extrinsic.q);
-    problem.SetParameterBlockConstant(state->extrinsic.t);
+  // The extrinsic: the prior of the retired data and the mounting (counted there once),
+  // rotation on the quaternion manifold; held when not optimized.
+  if (problem.HasParameterBlock(q_bc)) {
+    problem.AddResidualBlock(residuals::ExtrinsicPriorResidual::Create(snapshot.extrinsic_prior),
+                             nullptr, q_bc, t_bc);
+    problem.SetManifold(q_bc, new ceres::EigenQuaternionManifold);
+    if (!options.optimize_extrinsic) {
+      problem.SetParameterBlockConstant(q_bc);
+      problem.SetParameterBlockConstant(t_bc);
+    }
   }
   return Solve(options, &problem);
 }
 
-// The pose-update step.
+// The pose-update step: the window's poses free with their odometry priors; map and
+// extrinsic data (the gauge is fixed by the map).
 ceres::Solver::Summary PoseStep(const WindowSnapshot& snapshot, const BackendOptions& options,
                                 WindowState* state, int* blocks) {
   ceres::Problem problem;
   ceres::LossFunction* loss = MakeLoss(options);
-  *blocks = AddMeasurementResiduals(snapshot, options, state, &problem, loss);
+  const PinholeCamera camera(snapshot.camera);
+  const double* q_bc = state->extrinsic.q;
+  const double* t_bc = state->extrinsic.t;
+  *blocks = 0;
+  for (const CornerMeasurement& m : state->corner_measurements) {
+    if (!snapshot.markings[m.marking].mature) continue;
+    PoseBlocks& pose = state->frames[m.slot];
+    problem.AddResidualBlock(
+        residuals::CornerReprojectionPoseStepResidual::Create(
+            camera, m.uv, options.pixel_sigma_px, state->corners[m.marking][m.corner], q_bc, t_bc),
+        loss, pose.q, pose.t);
+    ++*blocks;
+  }
+  if (options.lane_residual == LaneResidual::kPpsr) {
+    for (const LanePixel& px : state->lane_pixels) {
+      const auto& cps = state->control_points[px.lane];
+      PoseBlocks& pose = state->frames[px.slot];
+      problem.AddResidualBlock(
+          residuals::PpsrPoseStepResidual::Create(camera, px.uv, options.pixel_sigma_px,
+                                                  cps[px.segment + 1], cps[px.segment + 2], q_bc,
+                                                  t_bc),
+          loss, pose.q, pose.t);
+      ++*blocks;
+    }
+  }
   if (*blocks == 0) {
     delete loss;
     return ceres::Solver::Summary();
@@ -284,22 +346,18 @@ ceres::Solver::Summary PoseStep(const WindowSnapshot& snapshot, const BackendOpt
   for (std::size_t i = 0; i < state->frames.size(); ++i) {
     PoseBlocks& pose = state->frames[i];
     if (!problem.HasParameterBlock(pose.q)) continue;
+    if (!snapshot.frames[i].in_window) {  // a context frame: data
+      problem.SetParameterBlockConstant(pose.q);
+      problem.SetParameterBlockConstant(pose.t);
+      continue;
+    }
     problem.AddResidualBlock(
         residuals::PosePriorResidual::Create(snapshot.frames[i].T_map_base_odom,
                                              options.pose_prior_sigma_trans_m,
                                              options.pose_prior_sigma_rot_rad),
         nullptr, pose.q, pose.t);
-    ConfigurePose(&problem, &pose, true);
+    problem.SetManifold(pose.q, new ceres::EigenQuaternionManifold);
   }
-  for (auto& corners : state->corners) {
-    for (auto& c : corners) ConfigurePointBlock(&problem, c.data(), false, true);
-  }
-  for (auto& cps : state->control_points) {
-    for (auto& c : cps) ConfigurePointBlock(&problem, c.data(), false, true);
-  }
-  problem.SetManifold(state->extrinsic.q, new ceres::EigenQuaternionManifold);
-  problem.SetParameterBlockConstant(state->extrinsic.q);
-  problem.SetParameterBlockConstant(state->extrinsic.t);
   return Solve(options, &problem);
 }
 
@@ -310,28 +368,26 @@ WindowResult SolveWindow(const WindowSnapshot& snapshot, const BackendOptions& o
   WindowResult result;
   result.sequence = snapshot.sequence;
   WindowState state(snapshot);
-  if (options.lane_residual != LaneResidual::kNone) AssignLanePixels(snapshot, options, &state);
+  CollectCornerMeasurements(snapshot, &state);
+  if (options.lane_residual != LaneResidual::kNone) CollectLanePixels(snapshot, options, &state);
 
+  // Map + extrinsic step, then the pose step, `rounds` times.
   bool usable = true;
-  for (int round = 0; round < options.rounds && usable; ++round) {
+  auto run = [&](bool map_step) {
     int blocks = 0;
-    ceres::Solver::Summary summary = MapStep(snapshot, options, &state, &blocks);
+    const ceres::Solver::Summary summary = map_step ? MapStep(snapshot, options, &state, &blocks)
+                                                    : PoseStep(snapshot, options, &state, &blocks);
+    if (blocks == 0) return;
     result.residual_blocks = std::max(result.residual_blocks, blocks);
-    if (blocks > 0) {
-      usable = summary.IsSolutionUsable();
-      result.iterations += static_cast<int>(summary.iterations.size());
-      if (round == 0) result.initial_cost = summary.initial_cost;
-      result.final_cost = summary.final_cost;
-      result.summary = summary.BriefReport();
-    }
-    if (usable && options.pose_update) {
-      summary = PoseStep(snapshot, options, &state, &blocks);
-      if (blocks > 0) {
-        usable = summary.IsSolutionUsable();
-        result.iterations += static_cast<int>(summary.iterations.size());
-        result.final_cost = summary.final_cost;
-      }
-    }
+    usable = summary.IsSolutionUsable();
+    result.iterations += static_cast<int>(summary.iterations.size());
+    if (result.initial_cost == 0.0) result.initial_cost = summary.initial_cost;
+    result.final_cost = summary.final_cost;
+    if (map_step || !usable) result.summary = summary.BriefReport();
+  };
+  for (int round = 0; round < options.rounds && usable; ++round) {
+    run(true);
+    if (usable && options.pose_update) run(false);
   }
 
   result.T_base_cam = state.extrinsic.ToIsometry();

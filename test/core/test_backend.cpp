@@ -60,8 +60,10 @@ Scene MakeScene(double pose_noise_m, unsigned seed) {
   WindowSnapshot& s = scene.snapshot;
   s.camera = TestCamera();
   s.T_base_cam = Extrinsic(5.6, 0.4);  // 0.6 deg pitch, 0.4 deg yaw off
-  s.t_base_cam_prior = scene.T_base_cam_true.translation();
-  s.q_base_cam_prior = Eigen::Quaterniond(s.T_base_cam.linear());  // the rough value
+  // The mounting prior: loose on the angles around the rough value, whose translation is the
+  // true one here.
+  s.extrinsic_prior = ExtrinsicPrior(s.T_base_cam, Eigen::Vector3d::Constant(2.0 * kDeg),
+                                     Eigen::Vector3d::Constant(0.02));
   for (int k = 0; k < 20; ++k) {
     const Eigen::Isometry3d T_true = Pose(1.0 * k, 0.0, 0.002 * k);
     scene.poses_true.push_back(T_true);
@@ -75,14 +77,15 @@ Scene MakeScene(double pose_noise_m, unsigned seed) {
   const std::vector<Eigen::Vector2d> centers = {{14, 1.2}, {22, -1.5}, {30, 0.8}};
   for (std::size_t m = 0; m < centers.size(); ++m) {
     const Eigen::Vector2d c = centers[m];
-    std::array<Eigen::Vector3d, 4> corners = {
-        Eigen::Vector3d(c.x() - 1.5, c.y() - 0.4, 0.05 * m),
-        Eigen::Vector3d(c.x() + 1.5, c.y() - 0.4, 0.05 * m),
-        Eigen::Vector3d(c.x() + 1.5, c.y() + 0.4, 0.05 * m),
-        Eigen::Vector3d(c.x() - 1.5, c.y() + 0.4, 0.05 * m)};
+    // On the road, which is the poses' z = 0 plane (the road-surface prior's premise).
+    std::array<Eigen::Vector3d, 4> corners = {Eigen::Vector3d(c.x() - 1.5, c.y() - 0.4, 0.0),
+                                              Eigen::Vector3d(c.x() + 1.5, c.y() - 0.4, 0.0),
+                                              Eigen::Vector3d(c.x() + 1.5, c.y() + 0.4, 0.0),
+                                              Eigen::Vector3d(c.x() - 1.5, c.y() + 0.4, 0.0)};
     scene.corners_true.push_back(corners);
     WindowMarking wm;
     wm.id = m + 1;
+    wm.mature = true;  // corrects poses (the map step runs first in each round)
     bool initialized = false;
     for (int k = 0; k < 20; ++k) {
       const Eigen::Isometry3d T_cam_map =
@@ -190,11 +193,13 @@ TEST(SolveWindow, PoseStepPullsNoisyPosesTowardTheTruth) {
   std::cout << "pose error lateral " << lateral_in << " -> " << lateral_out
             << " m, longitudinal " << longitudinal_in << " -> " << longitudinal_out << " m\n";
   // Markings 10-30 m ahead constrain the lateral position strongly (0.3 m ~ 20 px) and the
-  // longitudinal one weakly (0.3 m ~ 2 px): the lateral error must drop clearly. KNOWN
-  // DEFECT (issue 5): the longitudinal error grows (0.21 -> 0.31 m on this scene); this
-  // bound only keeps it from getting worse until that is fixed.
+  // longitudinal one weakly (0.3 m ~ 2 px, about the prior's sigma): the lateral error must
+  // drop clearly, the longitudinal one stays about where it was (0.21 -> 0.24 m here). It
+  // grew to 0.34 m while the scene's markings floated up to 0.1 m above the road the poses
+  // drive on: the road-surface prior then slid them, and the poses with them, along the
+  // viewing rays.
   EXPECT_LT(lateral_out, 0.5 * lateral_in);
-  EXPECT_LT(longitudinal_out, 1.6 * longitudinal_in);
+  EXPECT_LT(longitudinal_out, 1.25 * longitudinal_in);
 }
 
 TEST(SolveWindow, TrustBoundRejectsAWildExtrinsicChange) {

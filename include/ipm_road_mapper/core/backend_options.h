@@ -46,9 +46,20 @@ struct BackendOptions {
   double max_extrinsic_change_rad = 2.0 * M_PI / 180.0;  // trust bound per solve
   double max_extrinsic_change_m = 0.2;
   int max_lane_points_per_observation = 12;  // PPSR/PSR pixels per lane observation
-  // Height of map points in base_link of their closest observing frame ~ 0 (weak prior
-  // that fixes the extrinsic roll about the direction of travel; 0 disables it).
-  double ground_height_sigma_m = 0.2;
+  // Road-surface prior of free map points (with optimize_z): the height of a point in
+  // base_link of the window frame horizontally closest to it is ~0, with sigma
+  // hypot(road_height_sigma_m, road_height_sigma_per_m * distance). base_link's origin is on
+  // the road, so the road is known at the wheels and less so ahead of them (grade, waves).
+  // Without it a lane seen from a camera driving along it slides freely in the plane
+  // through the camera path (height against lateral offset), and the extrinsic roll about
+  // the direction of travel is unobservable.
+  double road_height_sigma_m = 0.02;
+  // Anchor of each free lane control point to its value at the start of a solve
+  // (along_lane_anchor_residual.h): tight along the lane (PPSR leaves that free), loose
+  // across it.
+  double lane_anchor_along_sigma_m = 0.05;
+  double lane_anchor_across_sigma_m = 0.5;
+  double road_height_sigma_per_m = 0.01;
 };
 
 // Reads the `backend` section; throws OptionsError naming the bad key.

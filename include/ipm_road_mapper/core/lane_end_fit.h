@@ -32,6 +32,7 @@ struct LaneEndFitOptions {
   double smoothness_weight = 1.0;     // lambda, per second difference (m^-2 relative to a point)
   double prior_sigma_m = 1.0;         // pull of each free control point to its current value
   double robust_scale_m = 0.3;        // Huber scale of the point residuals
+  double extension_weight = 0.1;      // weight of the growth points in the fit (see below)
 };
 
 // Extends and refines a lane's control points (phantom ends included, >= 4) with `points`
@@ -40,9 +41,13 @@ struct LaneEndFitOptions {
 // appended at the ends, so an interior control point keeps its index relative to the old
 // first one shifted by *added_at_start (if given). Non-finite points are ignored. Throws
 // std::invalid_argument when control_points has fewer than 4 points.
-std::vector<Eigen::Vector3d> FitLaneEnds(const std::vector<Eigen::Vector3d>& control_points,
-                                         const std::vector<Eigen::Vector3d>& points,
-                                         const LaneEndFitOptions& options,
-                                         int* added_at_start = nullptr);
+// `extension_points` (when given) decide the growth of step 1 instead of `points`, and join
+// the fit of step 2 with extension_weight: the mapper grows a lane with every point of low
+// enough IPM uncertainty but fits it to the selected ones (point selection keeps the
+// nearest, which never reach past the end; new control points need data all the same).
+std::vector<Eigen::Vector3d> FitLaneEnds(
+    const std::vector<Eigen::Vector3d>& control_points, const std::vector<Eigen::Vector3d>& points,
+    const LaneEndFitOptions& options, int* added_at_start = nullptr,
+    const std::vector<Eigen::Vector3d>* extension_points = nullptr);
 
 }  // namespace ipm_road_mapper

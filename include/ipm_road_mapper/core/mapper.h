@@ -12,6 +12,9 @@
 
 #include "ipm_road_mapper/core/backend.h"
 #include "ipm_road_mapper/core/class_table.h"
+#include "ipm_road_mapper/core/extrinsic_marginalization.h"
+#include "ipm_road_mapper/core/extrinsic_prior.h"
+#include "ipm_road_mapper/core/ipm.h"
 #include "ipm_road_mapper/core/mapper_options.h"
 #include "ipm_road_mapper/core/pinhole_camera.h"
 #include "ipm_road_mapper/core/road_map.h"
@@ -92,19 +95,40 @@ class Mapper {
 
  private:
   std::string ValidateInput(const FrameInput& input) const;
+  // Markings (mapper_markings.cpp). Re-fits each observation's rectangle with sides along the
+  // road: the tangent of the nearest mapped lane (the ground truth's rectangles follow the
+  // road; the vehicle's heading is 5 deg off on a 150 m curve 15 m ahead).
+  void OrientMarkingsAlongRoad(const Ipm& ipm, const FrameRecord& frame,
+                               std::vector<MarkingObservation>* markings);
+  // Unit tangent of the mapped lane nearest to p_map (within 8 m); zero when there is none.
+  Eigen::Vector3d RoadDirectionAt(const Eigen::Vector3d& p_map) const;
   void AddMarkings(const FrameObservations& observations, const FrameRecord& frame);
   // Lanes (mapper_lanes.cpp): association, start, growth, merging.
   void AddLanes(const FrameObservations& observations, const FrameRecord& frame);
   void StartLane(int class_id, const LaneMeasurement& measurement,
                  const std::vector<Eigen::Vector3d>& usable_map, const FrameRecord& frame);
-  // Grows and refines the lane's ends from the selected points of its recent observations.
-  void GrowLane(LaneElement* lane, std::size_t frame_index) const;
+  // Grows the lane's ends with this frame's usable points and refines them with the
+  // selected points of its recent observations.
+  void GrowLane(LaneElement* lane, std::size_t frame_index,
+                const std::vector<Eigen::Vector3d>& usable_map) const;
   // Selected pixels of every observation of the lane, IPMed now and put in the map.
   std::vector<Eigen::Vector3d> SelectedPointsMap(const LaneElement& lane) const;
   // The lane's control points re-fit to all of SelectedPointsMap (export, merges).
   std::vector<Eigen::Vector3d> RefitControlPoints(const LaneElement& lane) const;
   bool LanesRefinedByBackend() const;
+  // Back end (mapper_backend.cpp). A snapshot first retires what leaves the window: markings
+  // no longer observed in it, whose information moves into the extrinsic prior (their
+  // corners marginalized), and lane observations older than the lanes' context.
   WindowSnapshot BuildSnapshot();
+  void RetireMarking(MarkingElement* marking);
+  // End of input: markings that retired while the extrinsic was still rough are re-fit to
+  // all their observations with the final extrinsic and poses (each alone: poses and
+  // extrinsic are data).
+  void RefineRetiredMarkings();
+  // The frame whose base_link origin is horizontally closest to p_map (the vehicle passed
+  // there: its base_link plane is the road's plane there), and that plane as a prior.
+  std::size_t ClosestFrame(const Eigen::Vector3d& p_map) const;
+  void AddRoadPrior(int point, const Eigen::Vector3d& p_map, MarginalizationInput* input) const;
   void ApplyBackendResults();
   void ApplyResult(const WindowResult& result);
   void MergeLanes();
@@ -121,6 +145,7 @@ class Mapper {
   CameraIntrinsics camera_;  // of the last used frame
   std::uint64_t next_sequence_ = 1;
   std::unique_ptr<Backend> backend_;
+  ExtrinsicPrior extrinsic_prior_;  // the mounting prior plus everything retired
 };
 
 }  // namespace ipm_road_mapper

@@ -24,8 +24,11 @@ struct FrameRecord {
 // One observation of a marking, corners already in the element's corner order.
 struct MarkingMeasurement {
   std::size_t frame_index = 0;
-  std::array<Eigen::Vector2d, 4> corners_uv;    // pixel measurements z_k
+  std::array<Eigen::Vector2d, 4> corners_uv;    // pixel measurements z_k (flat-ground IPM)
   std::array<Eigen::Vector3d, 4> corners_base;  // their IPM ground points at observation time
+  // The instance's convex outline in the image: the back end re-measures the corners from
+  // it on a better road plane than base_link's (MeasureCornersOnPlane).
+  std::vector<Eigen::Vector2d> outline_uv;
 };
 
 // A mapped ground marking.
@@ -40,6 +43,7 @@ struct MarkingElement {
   std::size_t first_frame = 0, last_frame = 0;
   double first_seen = 0.0, last_seen = 0.0;
   bool optimized = false;  // the back end owns the estimate from now on
+  bool retired = false;    // left the window: its information is in the extrinsic prior
   Eigen::Vector3d Center() const {
     return 0.25 * (corners_map[0] + corners_map[1] + corners_map[2] + corners_map[3]);
   }
@@ -68,6 +72,8 @@ struct LaneElement {
   std::size_t first_frame = 0, last_frame = 0;
   double first_seen = 0.0, last_seen = 0.0;
   bool optimized = false;  // control points refined by a lane residual
+  // Observations of frames before this one no longer enter windows.
+  std::size_t retired_before_frame = 0;
 };
 
 // Elements and frames.

@@ -17,6 +17,7 @@
 #include <vector>
 
 #include "ipm_road_mapper/core/backend_options.h"
+#include "ipm_road_mapper/core/extrinsic_prior.h"
 #include "ipm_road_mapper/core/pinhole_camera.h"
 #include "ipm_road_mapper/core/road_map.h"
 
@@ -27,6 +28,9 @@ struct WindowFrame {
   std::size_t index = 0;
   Eigen::Isometry3d T_map_base = Eigen::Isometry3d::Identity();
   Eigen::Isometry3d T_map_base_odom = Eigen::Isometry3d::Identity();
+  // In the window: its pose is free in the pose step. Otherwise a context frame (older
+  // measurements of the window's elements were made from it): its pose is data.
+  bool in_window = true;
 };
 
 // A marking observed in the window, with its in-window measurements.
@@ -34,6 +38,12 @@ struct WindowMarking {
   std::uint64_t id = 0;
   std::array<Eigen::Vector3d, 4> corners_map;
   std::vector<MarkingMeasurement> measurements;
+  // The road's direction at the marking (tangent of the nearest lane; zero: unknown), along
+  // which its corners are re-measured.
+  Eigen::Vector3d axis_map = Eigen::Vector3d::Zero();
+  // Its estimate has been through an earlier solve: only such a marking corrects poses (a
+  // new one is where flat-ground IPM put it, meters off, and would drag them along).
+  bool mature = false;
 };
 
 // A lane observed in the window. `first_cp_index` is the lane's global index of
@@ -51,9 +61,9 @@ struct WindowSnapshot {
   std::uint64_t sequence = 0;
   CameraIntrinsics camera;
   Eigen::Isometry3d T_base_cam = Eigen::Isometry3d::Identity();
-  Eigen::Vector3d t_base_cam_prior = Eigen::Vector3d::Zero();  // t_0 of the translation prior
-  Eigen::Quaterniond q_base_cam_prior = Eigen::Quaterniond::Identity();  // rotation prior
-  std::vector<WindowFrame> frames;  // sorted by index
+  // What retired data (and the mounting prior) say about the extrinsic.
+  ExtrinsicPrior extrinsic_prior;
+  std::vector<WindowFrame> frames;  // sorted by index: the window and its context frames
   std::vector<WindowMarking> markings;
   std::vector<WindowLane> lanes;
 };
