@@ -41,6 +41,10 @@
 #include "ipm_road_mapper/core/rigid_transform.h"
 #include "ipm_road_mapper/core/vector_map.h"
 #include "ipm_road_mapper/ros/bag_input.h"
+#include "ipm_road_mapper/ros/extrinsic_source.h"
+#include "ipm_road_mapper/ros/map_files.h"
+#include "ipm_road_mapper/ros/mapper_config.h"
+#include "ipm_road_mapper/ros/mapping_session.h"
 #include "ipm_road_mapper/ros/msg_conversion.h"
 #include "ipm_road_mapper/ros/progress_meter.h"
 
@@ -63,19 +67,12 @@ struct Arguments {
 };
 
 // A file of the package (e.g. "config/mapper.yaml"); see the file comment for the search.
-std::string FindPackageFile(const std::string& relative) {
-  std::vector<std::string> roots;
-  const std::string package_path = ros::package::getPath("ipm_road_mapper");
-  if (!package_path.empty()) roots.push_back(package_path);
-  if (const char* source_dir = std::getenv("IRM_SOURCE_DIR")) roots.push_back(source_dir);
-  std::error_code error;
-  const fs::path exe = fs::read_symlink("/proc/self/exe", error);
-  if (!error) roots.push_back((exe.parent_path() / "../../share/ipm_road_mapper").string());
-  for (const std::string& root : roots) {
-    if (fs::exists(fs::path(root) / relative)) return (fs::path(root) / relative).string();
+std::string PackageFile(const std::string& relative) {
+  try {
+    return FindPackageFile(ros::package::getPath("ipm_road_mapper"), relative);
+  } catch (const OptionsError& e) {
+    throw InputError(e.what());
   }
-  throw InputError("cannot find the package's " + relative + " (set ROS_PACKAGE_PATH or " +
-                   "IRM_SOURCE_DIR, or pass the file explicitly)");
 }
 
 Arguments ParseArguments(int argc, char** argv) {
@@ -96,49 +93,42 @@ Arguments ParseArguments(int argc, char** argv) {
     *target = argv[++i];
   }
   if (args.bag.empty() || args.out.empty()) throw InputError(std::string(kUsage));
-  if (args.config.empty()) args.config = FindPackageFile("config/mapper.yaml");
-  if (args.classes.empty()) args.classes = FindPackageFile("config/classes.yaml");
+  if (args.config.empty()) args.config = PackageFile("config/mapper.yaml");
+  if (args.classes.empty()) args.classes = PackageFile("config/classes.yaml");
   return args;
 }
 
-// Loads the mapper config (a `base:` file is overlaid, see OptionsReader::FromFile).
-// `geo_origin` is read here until MapperOptions carries it; Child() marks it as known so
-// that LoadMapperOptions does not reject it.
-MapperOptions LoadConfig(const std::string& path, std::optional<GeoOrigin>* geo_origin) {
+// Loads the config (mapper options, geo_origin, the nodelet's `ros` section: the same loader
+// as the nodelet's, see mapper_config.h).
+MapperConfig LoadConfig(const std::string& path) {
   try {
-    OptionsReader reader = OptionsReader::FromFile(path);
-    *geo_origin = LoadGeoOrigin(reader.Child("geo_origin"));
-    return LoadMapperOptions(reader);
+    return LoadMapperConfigFile(path);
   } catch (const OptionsError& e) {
-    const std::string what = e.what();
-    throw InputError(what.rfind(path, 0) == 0 ? what : path + ": " + what);
+    throw InputError(e.what());
   }
 }
 
-// The rough extrinsic and where it came from.
+// The rough extrinsic and where it came from (ChooseExtrinsic, as the nodelet decides it).
 Eigen::Isometry3d FindExtrinsic(const rosbag::Bag& bag, const InputOptions& input,
                                 std::string* source) {
-  if (input.T_base_cam) {
-    *source = "config input.extrinsic";
-    return *input.T_base_cam;
+  std::string camera_frame;
+  if (!input.T_base_cam) {
+    rosbag::View masks(bag, rosbag::TopicQuery(input.mask_topic));
+    if (masks.size() == 0) throw InputError("topic " + input.mask_topic + " has no message");
+    const auto first = masks.begin()->instantiate<sensor_msgs::Image>();
+    camera_frame = first ? first->header.frame_id : "";
   }
-  rosbag::View masks(bag, rosbag::TopicQuery(input.mask_topic));
-  if (masks.size() == 0) throw InputError("topic " + input.mask_topic + " has no message");
-  const auto first = masks.begin()->instantiate<sensor_msgs::Image>();
-  const std::string camera_frame = first ? first->header.frame_id : "";
-  if (camera_frame.empty()) {
-    throw InputError(
-        "no extrinsic: the masks have no header.frame_id and the config has no "
-        "input.extrinsic");
-  }
-  Eigen::Isometry3d T_base_cam;
-  const std::string error = LookupStaticTransform(bag, input.base_frame, camera_frame, &T_base_cam);
+  const TransformLookup lookup = [&bag](const std::string& parent, const std::string& child,
+                                        Eigen::Isometry3d* T) {
+    return LookupStaticTransform(bag, parent, child, T);
+  };
+  ExtrinsicChoice choice;
+  const std::string error = ChooseExtrinsic(input, camera_frame, lookup, "/tf_static", &choice);
   if (!error.empty()) {
-    throw InputError("no extrinsic " + input.base_frame + " -> " + camera_frame + ": " + error +
-                     "; set input.extrinsic in the config or record /tf_static");
+    throw InputError(error + "; set input.extrinsic in the config or record /tf_static");
   }
-  *source = "/tf_static " + input.base_frame + " -> " + camera_frame;
-  return T_base_cam;
+  *source = choice.source;
+  return choice.T_base_cam;
 }
 
 // What the run did, for summary.txt.
@@ -201,40 +191,27 @@ std::string Summary(const Arguments& args, const Mapper& mapper, const FrameAsse
   return s.str();
 }
 
-// Hands a mask message to the assembler, or counts why it cannot be a frame.
+// Hands a mask message to the session, or counts why it cannot be a frame.
 void AddMask(const sensor_msgs::Image& msg, const CameraInfoTable& camera_infos, bool exact_sync,
-             FrameAssembler* assembler, Mapper* mapper) {
+             MappingSession* session) {
   cv::Mat mask;
   std::string error = ImageToMask(msg, &mask);
   if (!error.empty()) {
-    mapper->CountSkipped("bad_mask_encoding: " + error);
+    session->CountSkipped("bad_mask_encoding: " + error, nullptr);
     return;
   }
   CameraIntrinsics camera;
   error = camera_infos.Match(msg.header.stamp, exact_sync, &camera);
   if (!error.empty()) {
-    mapper->CountSkipped(error);
+    session->CountSkipped(error, nullptr);
     return;
   }
-  assembler->AddFrame(ToSeconds(msg.header.stamp), std::move(mask), camera);
-}
-
-// Runs the frames the assembler has decided through the mapper.
-void ProcessDecided(std::vector<FrameInput> frames, const std::vector<std::string>& skipped,
-                    Mapper* mapper) {
-  for (const std::string& reason : skipped) mapper->CountSkipped(reason);
-  for (const FrameInput& frame : frames) {
-    mapper->ProcessFrame(frame);
-    // Back-end step: the Mapper owns the optimizer (options.backend) and submits windows /
-    // merges results inside ProcessFrame; a per-frame step of the runner's own goes here.
-  }
+  session->AddFrame(ToSeconds(msg.header.stamp), std::move(mask), camera, nullptr);
 }
 
 void WriteOutputs(const std::string& dir, const VectorMap& map,
                   const std::optional<GeoOrigin>& geo_origin, const std::string& summary) {
-  SaveVectorMapJson(map, dir + "/map.json");
-  SaveGeoJson(map, geo_origin, dir + "/map.geojson");
-  WriteTumTrajectory(map.trajectory, dir + "/trajectory_tum.txt");
+  SaveMapFiles(map, geo_origin, MapFilePathsInFolder(dir));
   std::ofstream out(dir + "/summary.txt");
   out << summary;
   if (!out) throw std::runtime_error(dir + "/summary.txt: cannot write");
@@ -242,8 +219,8 @@ void WriteOutputs(const std::string& dir, const VectorMap& map,
 
 int Run(int argc, char** argv) {
   const Arguments args = ParseArguments(argc, argv);
-  std::optional<GeoOrigin> geo_origin;
-  const MapperOptions options = LoadConfig(args.config, &geo_origin);
+  const MapperConfig config = LoadConfig(args.config);
+  const MapperOptions& options = config.mapper;
   ClassTable classes;
   try {
     classes = ClassTable::LoadFile(args.classes);
@@ -273,8 +250,9 @@ int Run(int argc, char** argv) {
 
   const CameraInfoTable camera_infos = CameraInfoTable::Read(bag, input.camera_info_topic);
   const bool exact_sync = input.sync == "exact";
-  Mapper mapper(options, classes, T_base_cam);
-  FrameAssembler assembler(options.odometry);
+  // The same pipeline as the nodelet's; no odometry wait rule offline (the bag is complete).
+  MappingSession session(options, classes);
+  session.Start(T_base_cam);
   rosbag::View view(bag, rosbag::TopicQuery({input.mask_topic, input.odom_topic}));
   const std::size_t total_masks = rosbag::View(bag, rosbag::TopicQuery(input.mask_topic)).size();
   std::cerr << "map_from_bag: " << total_masks << " masks, " << camera_infos.size()
@@ -282,7 +260,6 @@ int Run(int argc, char** argv) {
 
   ProgressMeter progress(total_masks, "frames");
   const auto start = std::chrono::steady_clock::now();
-  std::vector<std::string> skipped;
   for (const rosbag::MessageInstance& message : view) {
     if (message.getTopic() == input.odom_topic) {
       const auto odometry = message.instantiate<nav_msgs::Odometry>();
@@ -292,33 +269,30 @@ int Run(int argc, char** argv) {
       if (!odometry || !OdometryToStampedPose(*odometry, &pose).empty()) {
         pose.T_map_base.matrix().setConstant(std::numeric_limits<double>::quiet_NaN());
       }
-      assembler.AddOdometry(pose);
+      session.AddOdometry(pose, nullptr);
     } else {
       const auto mask = message.instantiate<sensor_msgs::Image>();
       if (mask) {
-        AddMask(*mask, camera_infos, exact_sync, &assembler, &mapper);
+        AddMask(*mask, camera_infos, exact_sync, &session);
       } else {
-        mapper.CountSkipped("bad_mask_message: not a sensor_msgs/Image");
+        session.CountSkipped("bad_mask_message: not a sensor_msgs/Image", nullptr);
       }
       progress.Update(++stats.frames_read);
     }
-    skipped.clear();
-    ProcessDecided(assembler.PopReady(&skipped), skipped, &mapper);
   }
-  skipped.clear();
-  ProcessDecided(assembler.Flush(&skipped), skipped, &mapper);
-  mapper.Finish();  // the last window's solve, merged before the export
+  session.Finish(nullptr);  // waiting frames decided, the last window's solve merged
   progress.Finish();
   stats.wall_s = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
   stats.bag_span_s = (view.getEndTime() - view.getBeginTime()).toSec();
 
+  const Mapper& mapper = *session.mapper();
   VectorMap map = mapper.ExportMap();
   map.metadata["bag"] = args.bag;
   map.metadata["config"] = args.config;
   map.metadata["extrinsic_source"] = stats.extrinsic_source;
-  const std::string summary = Summary(args, mapper, assembler, map, stats);
+  const std::string summary = Summary(args, mapper, session.assembler(), map, stats);
   try {
-    WriteOutputs(args.out, map, geo_origin, summary);
+    WriteOutputs(args.out, map, config.geo_origin, summary);
   } catch (const std::exception& e) {
     std::cerr << "map_from_bag: error: " << e.what() << "\n";
     return 1;
