@@ -1,0 +1,88 @@
+// The nodelet's diagnostics (diagnostic_updater, on /diagnostics): four statuses,
+//   "<node>: inputs"    rates of masks, camera_info, synchronized pairs, odometry, images;
+//   "<node>: frames"    frames received / used / skipped by reason, masks dropped by the
+//                       sync (no camera_info), odometry counters, callback time;
+//   "<node>: optimizer" windows submitted / solved / dropped / unusable, solve time;
+//   "<node>: extrinsic" where the rough extrinsic came from, and how far the refined one
+//                       moved from it.
+// The status functions are pure (snapshot -> DiagnosticStatusWrapper) and unit-tested.
+#pragma once
+
+#include <diagnostic_updater/diagnostic_updater.h>
+#include <ros/node_handle.h>
+
+#include <Eigen/Geometry>
+#include <array>
+#include <atomic>
+#include <chrono>
+#include <cstdint>
+#include <functional>
+#include <map>
+#include <mutex>
+#include <string>
+
+#include "ipm_road_mapper/core/backend.h"
+#include "ipm_road_mapper/core/frame_assembler.h"
+#include "ipm_road_mapper/core/mapper.h"
+
+namespace ipm_road_mapper {
+
+// Inputs whose arrivals are counted.
+enum class MapperInput { kMask, kCameraInfo, kPair, kOdometry, kImage };
+constexpr std::size_t kMapperInputCount = 5;
+
+// Input arrivals since start and their rates over the last diagnostics period.
+struct InputStats {
+  std::array<std::uint64_t, kMapperInputCount> totals{};
+  std::array<double, kMapperInputCount> rates_hz{};
+};
+
+// The mapper's state as the diagnostics see it, copied under the nodelet's lock.
+struct MapperStatusSnapshot {
+  bool started = false;
+  std::string extrinsic_status;  // the source when started, else why it is missing
+  MapperCounters counters;       // of the Mapper (empty before start)
+  std::map<std::string, std::uint64_t> skipped_before_start;
+  FrameAssemblerCounters assembler;
+  bool backend_enabled = false;
+  BackendStats backend;
+  Eigen::Isometry3d T_base_cam_initial = Eigen::Isometry3d::Identity();
+  Eigen::Isometry3d T_base_cam = Eigen::Isometry3d::Identity();
+  std::uint64_t callbacks = 0;  // data callbacks timed
+  double callback_mean_ms = 0.0, callback_max_ms = 0.0;
+};
+
+// The four statuses (see the file comment). `previous` is the snapshot of the last update,
+// to tell what happened during the period (levels: WARN when frames arrived but none was
+// used, or the optimizer rejected a result since the last update).
+void FillInputStatus(const InputStats& inputs, diagnostic_updater::DiagnosticStatusWrapper* s);
+void FillFrameStatus(const MapperStatusSnapshot& now, const MapperStatusSnapshot& previous,
+                     const InputStats& inputs, diagnostic_updater::DiagnosticStatusWrapper* s);
+void FillOptimizerStatus(const MapperStatusSnapshot& now, const MapperStatusSnapshot& previous,
+                         diagnostic_updater::DiagnosticStatusWrapper* s);
+void FillExtrinsicStatus(const MapperStatusSnapshot& now,
+                         diagnostic_updater::DiagnosticStatusWrapper* s);
+
+// Owns the Updater; Count() may be called from any thread.
+class MapperDiagnostics {
+ public:
+  MapperDiagnostics(ros::NodeHandle& nh, ros::NodeHandle& private_nh, const std::string& name,
+                    std::function<MapperStatusSnapshot()> snapshot);
+
+  void Count(MapperInput input) { ++counts_[static_cast<std::size_t>(input)]; }
+
+  // Computes the rates, takes one snapshot and publishes (whatever ROS time does: the bag
+  // may be paused).
+  void Update();
+
+ private:
+  std::function<MapperStatusSnapshot()> snapshot_fn_;
+  diagnostic_updater::Updater updater_;
+  std::array<std::atomic<std::uint64_t>, kMapperInputCount> counts_{};
+  std::mutex mutex_;  // below
+  InputStats inputs_;
+  MapperStatusSnapshot now_, previous_;
+  std::chrono::steady_clock::time_point last_update_;
+};
+
+}  // namespace ipm_road_mapper

@@ -1,0 +1,31 @@
+// The exported map (core VectorMap) <-> the package's messages (msg/VectorMap.msg), and the
+// corrected trajectory -> nav_msgs/Path. Pure functions, unit-tested (test_vector_map_conversion).
+#pragma once
+
+#include <nav_msgs/Path.h>
+#include <ros/time.h>
+
+#include <string>
+#include <vector>
+
+#include "ipm_road_mapper/core/rigid_transform.h"
+#include "ipm_road_mapper/core/vector_map.h"
+#include "ipm_road_mapper/ros/vector_map_msg.h"
+
+namespace ipm_road_mapper {
+
+// VectorMap -> message in `frame_id` at `stamp`: markings (4 corners), lanes (control points,
+// phantom ends included), the refined extrinsic. Element stamps in seconds -> ros::Time.
+ipm_road_mapper::VectorMapMsg ToVectorMapMsg(const VectorMap& map, const std::string& frame_id,
+                                             const ros::Time& stamp);
+
+// Message -> VectorMap (frame_id from the header; trajectory and metadata empty; the
+// initial extrinsic is not carried and is set to the refined one).
+VectorMap FromVectorMapMsg(const ipm_road_mapper::VectorMapMsg& msg);
+
+// The newest `max_poses` poses of a trajectory (all when max_poses <= 0) as a Path in
+// `frame_id`; the path's stamp is that of its newest pose (or `fallback_stamp` if empty).
+nav_msgs::Path ToPathMsg(const std::vector<StampedPose>& trajectory, const std::string& frame_id,
+                         int max_poses, const ros::Time& fallback_stamp);
+
+}  // namespace ipm_road_mapper

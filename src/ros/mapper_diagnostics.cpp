@@ -1,0 +1,170 @@
+#include "ipm_road_mapper/ros/mapper_diagnostics.h"
+
+#include <diagnostic_msgs/DiagnosticStatus.h>
+
+#include <algorithm>
+#include <cmath>
+#include <numeric>
+
+#include "ipm_road_mapper/core/rigid_transform.h"
+
+namespace ipm_road_mapper {
+namespace {
+
+using diagnostic_msgs::DiagnosticStatus;
+using diagnostic_updater::DiagnosticStatusWrapper;
+
+constexpr std::array<const char*, kMapperInputCount> kInputNames = {
+    "masks", "camera_info", "mask+camera_info pairs", "odometry", "images"};
+
+std::uint64_t Total(const std::map<std::string, std::uint64_t>& m) {
+  std::uint64_t n = 0;
+  for (const auto& [key, count] : m) n += count;
+  return n;
+}
+
+// Skip counts of the Mapper and, before it started, of the session.
+std::map<std::string, std::uint64_t> AllSkipped(const MapperStatusSnapshot& s) {
+  return s.started ? s.counters.frames_skipped : s.skipped_before_start;
+}
+
+}  // namespace
+
+void FillInputStatus(const InputStats& inputs, DiagnosticStatusWrapper* s) {
+  for (std::size_t i = 0; i < kMapperInputCount; ++i) {
+    s->addf(std::string(kInputNames[i]) + " rate (Hz)", "%.2f", inputs.rates_hz[i]);
+    s->add(std::string(kInputNames[i]) + " received", inputs.totals[i]);
+  }
+  const auto rate = [&](MapperInput input) { return inputs.rates_hz[static_cast<int>(input)]; };
+  if (rate(MapperInput::kMask) <= 0.0) {
+    s->summary(DiagnosticStatus::WARN, "no masks");
+  } else if (rate(MapperInput::kPair) <= 0.0) {
+    s->summary(DiagnosticStatus::WARN, "masks arrive but none pairs with a camera_info");
+  } else if (rate(MapperInput::kOdometry) <= 0.0) {
+    s->summary(DiagnosticStatus::WARN, "masks arrive but no odometry");
+  } else {
+    s->summary(DiagnosticStatus::OK, "inputs flowing");
+  }
+}
+
+void FillFrameStatus(const MapperStatusSnapshot& now, const MapperStatusSnapshot& previous,
+                     const InputStats& inputs, DiagnosticStatusWrapper* s) {
+  const auto skipped = AllSkipped(now);
+  const std::uint64_t skipped_total = Total(skipped);
+  const std::uint64_t used = now.counters.frames_used;
+  const std::uint64_t masks = inputs.totals[static_cast<int>(MapperInput::kMask)];
+  const std::uint64_t pairs = inputs.totals[static_cast<int>(MapperInput::kPair)];
+  s->add("frames used", used);
+  s->add("frames skipped", skipped_total);
+  for (const auto& [reason, count] : skipped) s->add("skipped: " + reason, count);
+  s->add("masks dropped by the sync (no camera_info)", masks > pairs ? masks - pairs : 0);
+  s->add("frames waiting for odometry", now.started ? now.assembler.frames_received -
+                                                          now.assembler.frames_ready -
+                                                          Total(now.assembler.frames_skipped)
+                                                    : 0);
+  s->add("odometry used", now.assembler.odometry_used);
+  s->add("odometry bad", now.assembler.bad_odometry);
+  s->add("odometry out of order", now.assembler.odometry_out_of_order);
+  s->add("time jumps", now.assembler.time_jumps);
+  s->addf("callback time mean (ms)", "%.2f", now.callback_mean_ms);
+  s->addf("callback time max (ms)", "%.2f", now.callback_max_ms);
+  const std::uint64_t new_used = used - std::min(used, previous.counters.frames_used);
+  const std::uint64_t new_skipped =
+      skipped_total - std::min(skipped_total, Total(AllSkipped(previous)));
+  if (new_used == 0 && new_skipped > 0) {
+    s->summary(DiagnosticStatus::WARN, "frames skipped, none used");
+  } else if (new_skipped > 0) {
+    s->summary(DiagnosticStatus::OK, "mapping (some frames skipped)");
+  } else {
+    s->summary(DiagnosticStatus::OK, new_used > 0 ? "mapping" : "idle");
+  }
+}
+
+void FillOptimizerStatus(const MapperStatusSnapshot& now, const MapperStatusSnapshot& previous,
+                         DiagnosticStatusWrapper* s) {
+  const BackendStats& b = now.backend;
+  s->add("enabled", now.backend_enabled);
+  s->add("windows submitted", b.submitted);
+  s->add("windows solved", b.solved);
+  s->add("windows dropped (queue full)", b.dropped_queue_full);
+  s->add("windows unusable", b.unusable);
+  s->add("results applied", now.counters.results_applied);
+  s->add("results rejected", now.counters.results_rejected);
+  const std::vector<double>& t = b.solve_times_s;
+  const double total = std::accumulate(t.begin(), t.end(), 0.0);
+  s->addf("solve time last (ms)", "%.1f", t.empty() ? 0.0 : 1e3 * t.back());
+  s->addf("solve time mean (ms)", "%.1f", t.empty() ? 0.0 : 1e3 * total / t.size());
+  s->addf("solve time max (ms)", "%.1f",
+          t.empty() ? 0.0 : 1e3 * *std::max_element(t.begin(), t.end()));
+  if (!now.backend_enabled) {
+    s->summary(DiagnosticStatus::OK, "disabled (front end only)");
+  } else if (b.unusable > previous.backend.unusable) {
+    s->summary(DiagnosticStatus::WARN, "a window solve was unusable");
+  } else {
+    s->summary(DiagnosticStatus::OK, "ok");
+  }
+}
+
+void FillExtrinsicStatus(const MapperStatusSnapshot& now, DiagnosticStatusWrapper* s) {
+  s->add("source", now.extrinsic_status);
+  if (!now.started) {
+    s->summary(DiagnosticStatus::WARN, "waiting for the rough extrinsic");
+    return;
+  }
+  const double change_deg =
+      RotationAngleBetween(now.T_base_cam_initial, now.T_base_cam) * 180.0 / M_PI;
+  const double change_m =
+      (now.T_base_cam.translation() - now.T_base_cam_initial.translation()).norm();
+  const Eigen::Vector3d t = now.T_base_cam.translation();
+  const Eigen::Vector3d rpy = RpyFromRotation(now.T_base_cam.linear()) * 180.0 / M_PI;
+  s->addf("change rotation (deg)", "%.4f", change_deg);
+  s->addf("change translation (m)", "%.4f", change_m);
+  s->addf("refined xyz (m)", "%.4f %.4f %.4f", t.x(), t.y(), t.z());
+  s->addf("refined rpy (deg)", "%.4f %.4f %.4f", rpy.x(), rpy.y(), rpy.z());
+  s->summary(DiagnosticStatus::OK, "known");
+}
+
+MapperDiagnostics::MapperDiagnostics(ros::NodeHandle& nh, ros::NodeHandle& private_nh,
+                                     const std::string& name,
+                                     std::function<MapperStatusSnapshot()> snapshot)
+    : snapshot_fn_(std::move(snapshot)),
+      updater_(nh, private_nh, name),
+      last_update_(std::chrono::steady_clock::now()) {
+  updater_.setHardwareID("ipm_road_mapper");
+  auto task = [this](auto fill) {
+    return [this, fill](DiagnosticStatusWrapper& s) {
+      std::lock_guard<std::mutex> lock(mutex_);
+      fill(s);
+    };
+  };
+  updater_.add("inputs",
+               task([this](DiagnosticStatusWrapper& s) { FillInputStatus(inputs_, &s); }));
+  updater_.add("frames", task([this](DiagnosticStatusWrapper& s) {
+                 FillFrameStatus(now_, previous_, inputs_, &s);
+               }));
+  updater_.add("optimizer", task([this](DiagnosticStatusWrapper& s) {
+                 FillOptimizerStatus(now_, previous_, &s);
+               }));
+  updater_.add("extrinsic",
+               task([this](DiagnosticStatusWrapper& s) { FillExtrinsicStatus(now_, &s); }));
+}
+
+void MapperDiagnostics::Update() {
+  MapperStatusSnapshot snapshot = snapshot_fn_();
+  {
+    std::lock_guard<std::mutex> lock(mutex_);
+    const auto wall = std::chrono::steady_clock::now();
+    const double dt = std::chrono::duration<double>(wall - last_update_).count();
+    for (std::size_t i = 0; i < kMapperInputCount; ++i) {
+      const std::uint64_t total = counts_[i].load();
+      inputs_.rates_hz[i] = dt > 0 ? (total - inputs_.totals[i]) / dt : 0.0;
+      inputs_.totals[i] = total;
+    }
+    last_update_ = wall;
+    previous_ = std::move(now_);
+    now_ = std::move(snapshot);
+  }
+  updater_.force_update();
+}
+
+}  // namespace ipm_road_mapper

@@ -1,0 +1,149 @@
+#include "ipm_road_mapper/ros/marker_builder.h"
+
+#include <array>
+#include <cstdint>
+#include <exception>
+#include <vector>
+
+#include "ipm_road_mapper/core/catmull_rom_spline.h"
+
+namespace ipm_road_mapper {
+namespace {
+
+constexpr const char* kLaneNs = "lanes";
+constexpr const char* kControlPointNs = "lane_control_points";
+constexpr const char* kMarkingNs = "markings";
+constexpr const char* kLabelNs = "marking_labels";
+
+std_msgs::ColorRGBA Rgba(float r, float g, float b, float a = 1.0f) {
+  std_msgs::ColorRGBA c;
+  c.r = r;
+  c.g = g;
+  c.b = b;
+  c.a = a;
+  return c;
+}
+
+int MarkerId(std::uint64_t element_id) { return static_cast<int>(element_id & 0x7fffffffu); }
+
+geometry_msgs::Point ToPoint(const Eigen::Vector3d& p) {
+  geometry_msgs::Point msg;
+  msg.x = p.x();
+  msg.y = p.y();
+  msg.z = p.z();
+  return msg;
+}
+
+visualization_msgs::Marker NewMarker(const std::string& ns, int id, int type,
+                                     const std::string& frame_id, const ros::Time& stamp) {
+  visualization_msgs::Marker m;
+  m.header.frame_id = frame_id;
+  m.header.stamp = stamp;
+  m.ns = ns;
+  m.id = id;
+  m.type = type;
+  m.action = visualization_msgs::Marker::ADD;
+  m.pose.orientation.w = 1.0;
+  m.frame_locked = false;
+  return m;
+}
+
+// Points along the lane's curve; the control points themselves when the spline cannot be
+// built (fewer than 4 or non-finite points).
+std::vector<Eigen::Vector3d> LaneSamples(const MapLane& lane, double spacing_m) {
+  try {
+    return CatmullRomSpline(lane.control_points_map).SampleByArcLength(spacing_m);
+  } catch (const std::exception&) {
+    return lane.control_points_map;
+  }
+}
+
+}  // namespace
+
+std_msgs::ColorRGBA ClassColor(int class_id, const std::string& class_name) {
+  if (class_name.find("yellow") != std::string::npos) return Rgba(1.0f, 0.85f, 0.1f);
+  if (class_name.find("white") != std::string::npos) return Rgba(0.95f, 0.95f, 0.95f);
+  static const std::array<std::array<float, 3>, 12> kPalette = {{{0.90f, 0.10f, 0.29f},
+                                                                 {0.24f, 0.71f, 0.29f},
+                                                                 {0.26f, 0.39f, 0.85f},
+                                                                 {0.96f, 0.51f, 0.19f},
+                                                                 {0.57f, 0.12f, 0.71f},
+                                                                 {0.27f, 0.94f, 0.94f},
+                                                                 {0.94f, 0.20f, 0.90f},
+                                                                 {0.74f, 0.96f, 0.05f},
+                                                                 {0.98f, 0.75f, 0.83f},
+                                                                 {0.0f, 0.50f, 0.50f},
+                                                                 {0.60f, 0.39f, 0.14f},
+                                                                 {0.50f, 0.0f, 0.0f}}};
+  const auto& c =
+      kPalette[static_cast<std::size_t>(class_id < 0 ? -class_id : class_id) % kPalette.size()];
+  return Rgba(c[0], c[1], c[2]);
+}
+
+MarkerBuilder::MarkerBuilder(double lane_sample_spacing_m)
+    : lane_sample_spacing_m_(lane_sample_spacing_m > 0.0 ? lane_sample_spacing_m : 0.5) {}
+
+visualization_msgs::MarkerArray MarkerBuilder::Build(const VectorMap& map,
+                                                     const std::string& frame_id,
+                                                     const ros::Time& stamp) {
+  using visualization_msgs::Marker;
+  visualization_msgs::MarkerArray out;
+  std::set<std::pair<std::string, int>> now;
+  auto add = [&](Marker marker) {
+    now.insert({marker.ns, marker.id});
+    out.markers.push_back(std::move(marker));
+  };
+  for (const MapLane& lane : map.lanes) {
+    const std_msgs::ColorRGBA color = ClassColor(lane.class_id, lane.class_name);
+    Marker line = NewMarker(kLaneNs, MarkerId(lane.id), Marker::LINE_STRIP, frame_id, stamp);
+    line.scale.x = 0.15;  // line width, m (a painted lane line)
+    line.color = color;
+    for (const Eigen::Vector3d& p : LaneSamples(lane, lane_sample_spacing_m_)) {
+      line.points.push_back(ToPoint(p));
+    }
+    if (line.points.size() >= 2) add(line);
+    Marker points =
+        NewMarker(kControlPointNs, MarkerId(lane.id), Marker::SPHERE_LIST, frame_id, stamp);
+    points.scale.x = points.scale.y = points.scale.z = 0.3;
+    points.color = Rgba(color.r * 0.6f, color.g * 0.6f, color.b * 0.6f + 0.4f);
+    for (const Eigen::Vector3d& c : lane.control_points_map) points.points.push_back(ToPoint(c));
+    if (!points.points.empty()) add(points);
+  }
+  for (const MapMarking& marking : map.markings) {
+    const std_msgs::ColorRGBA color = ClassColor(marking.class_id, marking.class_name);
+    Marker outline =
+        NewMarker(kMarkingNs, MarkerId(marking.id), Marker::LINE_STRIP, frame_id, stamp);
+    outline.scale.x = 0.08;
+    outline.color = color;
+    for (int i = 0; i <= 4; ++i) outline.points.push_back(ToPoint(marking.corners_map[i % 4]));
+    add(outline);
+    Marker label =
+        NewMarker(kLabelNs, MarkerId(marking.id), Marker::TEXT_VIEW_FACING, frame_id, stamp);
+    label.pose.position = ToPoint(marking.Center() + Eigen::Vector3d(0.0, 0.0, 0.5));
+    label.scale.z = 0.6;  // text height, m
+    label.color = color;
+    label.text = marking.class_name.empty() ? "class " + std::to_string(marking.class_id)
+                                            : marking.class_name;
+    add(label);
+  }
+  for (const auto& [ns, id] : published_) {
+    if (now.count({ns, id})) continue;
+    Marker gone = NewMarker(ns, id, Marker::LINE_STRIP, frame_id, stamp);
+    gone.action = Marker::DELETE;
+    out.markers.push_back(gone);
+  }
+  published_ = std::move(now);
+  return out;
+}
+
+visualization_msgs::MarkerArray MarkerBuilder::Clear() {
+  visualization_msgs::MarkerArray out;
+  visualization_msgs::Marker all;
+  all.action = visualization_msgs::Marker::DELETEALL;
+  all.pose.orientation.w = 1.0;
+  out.markers.push_back(all);
+  published_.clear();
+  return out;
+}
+
+}  // namespace ipm_road_mapper

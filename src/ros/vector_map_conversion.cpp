@@ -1,0 +1,114 @@
+#include "ipm_road_mapper/ros/vector_map_conversion.h"
+
+#include <algorithm>
+
+#include "ipm_road_mapper/ros/msg_conversion.h"
+
+namespace ipm_road_mapper {
+namespace {
+
+geometry_msgs::Point ToPoint(const Eigen::Vector3d& p) {
+  geometry_msgs::Point msg;
+  msg.x = p.x();
+  msg.y = p.y();
+  msg.z = p.z();
+  return msg;
+}
+
+Eigen::Vector3d FromPoint(const geometry_msgs::Point& p) { return {p.x, p.y, p.z}; }
+
+// A stamp that ros::Time accepts (it throws on negative or out-of-range seconds).
+ros::Time SafeTime(double seconds) {
+  if (!(seconds >= 0.0) || seconds > 4294967295.0) return ros::Time(0);
+  return FromSeconds(seconds);
+}
+
+}  // namespace
+
+ipm_road_mapper::VectorMapMsg ToVectorMapMsg(const VectorMap& map, const std::string& frame_id,
+                                             const ros::Time& stamp) {
+  ipm_road_mapper::VectorMapMsg msg;
+  msg.header.frame_id = frame_id;
+  msg.header.stamp = stamp;
+  msg.markings.reserve(map.markings.size());
+  for (const MapMarking& marking : map.markings) {
+    ipm_road_mapper::MarkingPolygon m;
+    m.id = marking.id;
+    m.class_id = marking.class_id;
+    m.class_name = marking.class_name;
+    for (int i = 0; i < 4; ++i) m.corners[i] = ToPoint(marking.corners_map[i]);
+    m.observations = marking.observations;
+    m.first_seen = SafeTime(marking.first_seen);
+    m.last_seen = SafeTime(marking.last_seen);
+    msg.markings.push_back(m);
+  }
+  msg.lanes.reserve(map.lanes.size());
+  for (const MapLane& lane : map.lanes) {
+    ipm_road_mapper::LaneSpline l;
+    l.id = lane.id;
+    l.class_id = lane.class_id;
+    l.class_name = lane.class_name;
+    l.style = lane.style.empty() ? "unknown" : lane.style;
+    for (const Eigen::Vector3d& c : lane.control_points_map) l.control_points.push_back(ToPoint(c));
+    l.observations = lane.observations;
+    l.first_seen = SafeTime(lane.first_seen);
+    l.last_seen = SafeTime(lane.last_seen);
+    msg.lanes.push_back(l);
+  }
+  msg.base_to_camera = IsometryToTransform(map.T_base_cam);
+  return msg;
+}
+
+VectorMap FromVectorMapMsg(const ipm_road_mapper::VectorMapMsg& msg) {
+  VectorMap map;
+  map.frame_id = msg.header.frame_id;
+  for (const auto& m : msg.markings) {
+    MapMarking marking;
+    marking.id = m.id;
+    marking.class_id = m.class_id;
+    marking.class_name = m.class_name;
+    for (int i = 0; i < 4; ++i) marking.corners_map[i] = FromPoint(m.corners[i]);
+    marking.observations = m.observations;
+    marking.first_seen = ToSeconds(m.first_seen);
+    marking.last_seen = ToSeconds(m.last_seen);
+    map.markings.push_back(marking);
+  }
+  for (const auto& l : msg.lanes) {
+    MapLane lane;
+    lane.id = l.id;
+    lane.class_id = l.class_id;
+    lane.class_name = l.class_name;
+    lane.style = l.style == "unknown" ? "" : l.style;
+    for (const auto& c : l.control_points) lane.control_points_map.push_back(FromPoint(c));
+    lane.observations = l.observations;
+    lane.first_seen = ToSeconds(l.first_seen);
+    lane.last_seen = ToSeconds(l.last_seen);
+    map.lanes.push_back(lane);
+  }
+  Eigen::Isometry3d T = Eigen::Isometry3d::Identity();
+  if (TransformToIsometry(msg.base_to_camera, &T).empty()) map.T_base_cam = T;
+  map.T_base_cam_initial = map.T_base_cam;
+  return map;
+}
+
+nav_msgs::Path ToPathMsg(const std::vector<StampedPose>& trajectory, const std::string& frame_id,
+                         int max_poses, const ros::Time& fallback_stamp) {
+  nav_msgs::Path path;
+  path.header.frame_id = frame_id;
+  path.header.stamp = trajectory.empty() ? fallback_stamp : SafeTime(trajectory.back().stamp);
+  std::size_t first = 0;
+  if (max_poses > 0 && trajectory.size() > static_cast<std::size_t>(max_poses)) {
+    first = trajectory.size() - static_cast<std::size_t>(max_poses);
+  }
+  path.poses.reserve(trajectory.size() - first);
+  for (std::size_t i = first; i < trajectory.size(); ++i) {
+    geometry_msgs::PoseStamped pose;
+    pose.header.frame_id = frame_id;
+    pose.header.stamp = SafeTime(trajectory[i].stamp);
+    pose.pose = IsometryToPose(trajectory[i].T_map_base);
+    path.poses.push_back(pose);
+  }
+  return path;
+}
+
+}  // namespace ipm_road_mapper
