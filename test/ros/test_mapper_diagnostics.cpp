@@ -1,0 +1,106 @@
+// The diagnostics' status functions: skip reasons appear as keys with their counts (before
+// and after the Mapper started), levels say when nothing is used or inputs are missing, the
+// extrinsic change is reported in degrees and meters.
+#include <gtest/gtest.h>
+
+#include "ipm_road_mapper/ros/mapper_diagnostics.h"
+
+namespace ipm_road_mapper {
+namespace {
+
+using diagnostic_msgs::DiagnosticStatus;
+using diagnostic_updater::DiagnosticStatusWrapper;
+
+std::string Value(const DiagnosticStatusWrapper& s, const std::string& key) {
+  for (const auto& kv : s.values) {
+    if (kv.key == key) return kv.value;
+  }
+  return "<missing>";
+}
+
+InputStats Flowing() {
+  InputStats in;
+  in.rates_hz = {20.0, 20.0, 20.0, 50.0, 0.0};
+  in.totals = {100, 98, 98, 250, 0};
+  return in;
+}
+
+TEST(MapperDiagnostics, SkipReasonsAndSyncDrops) {
+  MapperStatusSnapshot previous, now;
+  now.started = true;
+  now.counters.frames_used = 90;
+  now.counters.frames_skipped = {{"bad_mask", 3}, {"no_odometry", 5}};
+  previous = now;
+  previous.counters.frames_used = 80;
+  DiagnosticStatusWrapper s;
+  FillFrameStatus(now, previous, Flowing(), &s);
+  EXPECT_EQ(Value(s, "frames used"), "90");
+  EXPECT_EQ(Value(s, "frames skipped"), "8");
+  EXPECT_EQ(Value(s, "skipped: bad_mask"), "3");
+  EXPECT_EQ(Value(s, "skipped: no_odometry"), "5");
+  EXPECT_EQ(Value(s, "masks dropped by the sync (no camera_info)"), "2");
+  EXPECT_EQ(s.level, DiagnosticStatus::OK);
+
+  // Frames skipped during the period and none used: WARN.
+  previous = now;
+  now.counters.frames_skipped["bad_mask"] = 10;
+  DiagnosticStatusWrapper warn;
+  FillFrameStatus(now, previous, Flowing(), &warn);
+  EXPECT_EQ(warn.level, DiagnosticStatus::WARN);
+}
+
+TEST(MapperDiagnostics, BeforeStartTheSessionCountsAreShown) {
+  MapperStatusSnapshot now;
+  now.skipped_before_start = {{"no_extrinsic", 7}};
+  DiagnosticStatusWrapper s;
+  FillFrameStatus(now, MapperStatusSnapshot(), Flowing(), &s);
+  EXPECT_EQ(Value(s, "skipped: no_extrinsic"), "7");
+  EXPECT_EQ(s.level, DiagnosticStatus::WARN);
+  DiagnosticStatusWrapper e;
+  now.extrinsic_status = "no extrinsic base_link -> cam: frame does not exist";
+  FillExtrinsicStatus(now, &e);
+  EXPECT_EQ(e.level, DiagnosticStatus::WARN);
+  EXPECT_EQ(Value(e, "source"), now.extrinsic_status);
+}
+
+TEST(MapperDiagnostics, InputLevels) {
+  InputStats in = Flowing();
+  DiagnosticStatusWrapper ok;
+  FillInputStatus(in, &ok);
+  EXPECT_EQ(ok.level, DiagnosticStatus::OK);
+  EXPECT_EQ(Value(ok, "masks rate (Hz)"), "20.00");
+  in.rates_hz[static_cast<int>(MapperInput::kOdometry)] = 0.0;
+  DiagnosticStatusWrapper no_odom;
+  FillInputStatus(in, &no_odom);
+  EXPECT_EQ(no_odom.level, DiagnosticStatus::WARN);
+  EXPECT_NE(no_odom.message.find("odometry"), std::string::npos);
+}
+
+TEST(MapperDiagnostics, ExtrinsicChangeAndSolveTimes) {
+  MapperStatusSnapshot now;
+  now.started = true;
+  now.extrinsic_status = "tf base_link -> cam";
+  now.T_base_cam.linear() =
+      Eigen::AngleAxisd(0.5 * M_PI / 180.0, Eigen::Vector3d::UnitY()).toRotationMatrix();
+  now.T_base_cam.translation() = Eigen::Vector3d(0.03, 0.0, 0.04);
+  DiagnosticStatusWrapper e;
+  FillExtrinsicStatus(now, &e);
+  EXPECT_EQ(Value(e, "change rotation (deg)"), "0.5000");
+  EXPECT_EQ(Value(e, "change translation (m)"), "0.0500");
+  now.backend_enabled = true;
+  now.backend.solved = 2;
+  now.backend.solve_times_s = {0.1, 0.3};
+  DiagnosticStatusWrapper o;
+  FillOptimizerStatus(now, MapperStatusSnapshot(), &o);
+  EXPECT_EQ(Value(o, "solve time mean (ms)"), "200.0");
+  EXPECT_EQ(Value(o, "solve time max (ms)"), "300.0");
+  EXPECT_EQ(o.level, DiagnosticStatus::OK);
+  MapperStatusSnapshot later = now;
+  later.backend.unusable = 1;
+  DiagnosticStatusWrapper w;
+  FillOptimizerStatus(later, now, &w);
+  EXPECT_EQ(w.level, DiagnosticStatus::WARN);
+}
+
+}  // namespace
+}  // namespace ipm_road_mapper
