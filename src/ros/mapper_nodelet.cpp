@@ -49,22 +49,25 @@ void MapperNodelet::LoadParameters() {
 void MapperNodelet::SetUpOutputs() {
   ros::NodeHandle& nh = getNodeHandle();
   ros::NodeHandle& private_nh = getPrivateNodeHandle();
-  ros::NodeHandle& mt_private_nh = getMTPrivateNodeHandle();
+  ros::NodeHandle output_nh(private_nh);  // timers and services on our own queue
+  output_nh.setCallbackQueue(&output_queue_);
   map_publisher_ = std::make_unique<MapPublisher>(private_nh, config_.ros.path_max_poses);
   corrected_odom_pub_ = private_nh.advertise<nav_msgs::Odometry>("corrected_odom", 10);
   debug_image_ = std::make_unique<DebugImagePublisher>(
       nh, private_nh, config_.mapper.input.image_topic, config_.mapper, classes_);
   diagnostics_ = std::make_unique<MapperDiagnostics>(nh, private_nh, node_name_,
                                                      [this] { return Snapshot(); });
-  save_srv_ = mt_private_nh.advertiseService("save_map", &MapperNodelet::OnSaveMap, this);
-  reset_srv_ = mt_private_nh.advertiseService("reset", &MapperNodelet::OnReset, this);
+  save_srv_ = output_nh.advertiseService("save_map", &MapperNodelet::OnSaveMap, this);
+  reset_srv_ = output_nh.advertiseService("reset", &MapperNodelet::OnReset, this);
   // Wall timers: a paused or finished bag freezes ROS time, the outputs must still go out.
   publish_timer_ =
-      mt_private_nh.createWallTimer(ros::WallDuration(1.0 / config_.ros.publish_rate_hz),
-                                    [this](const ros::WallTimerEvent&) { OnPublishTimer(); });
+      output_nh.createWallTimer(ros::WallDuration(1.0 / config_.ros.publish_rate_hz),
+                                [this](const ros::WallTimerEvent&) { OnPublishTimer(); });
   diagnostics_timer_ =
-      mt_private_nh.createWallTimer(ros::WallDuration(config_.ros.diagnostics_period_s),
-                                    [this](const ros::WallTimerEvent&) { diagnostics_->Update(); });
+      output_nh.createWallTimer(ros::WallDuration(config_.ros.diagnostics_period_s),
+                                [this](const ros::WallTimerEvent&) { diagnostics_->Update(); });
+  output_spinner_ = std::make_unique<ros::AsyncSpinner>(1, &output_queue_);
+  output_spinner_->start();
 }
 
 void MapperNodelet::SetUpInputs() {
@@ -344,6 +347,7 @@ void MapperNodelet::Shutdown() {
   mask_sub_.unsubscribe();
   info_sub_.unsubscribe();
   if (debug_image_) debug_image_->Shutdown();
+  if (output_spinner_) output_spinner_->stop();  // joins the output thread
   std::optional<VectorMap> final_map;
   {
     std::lock_guard<std::mutex> lock(mutex_);

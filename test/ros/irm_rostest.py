@@ -6,16 +6,49 @@ it waited for.
 """
 import os
 import subprocess
+import sys
 import threading
 import time
 
+import rosgraph
 import rospy
 import yaml
 from diagnostic_msgs.msg import DiagnosticArray
 from nodelet.srv import NodeletList, NodeletLoad, NodeletUnload
+from sensor_msgs.msg import CameraInfo, Image
 
 SOURCE_DIR = os.path.abspath(os.path.join(os.path.dirname(__file__), "..", ".."))
 CONFIG = os.path.join(SOURCE_DIR, "config", "mapper.yaml")
+sys.path.insert(0, os.path.join(SOURCE_DIR, "test", "tools"))
+import make_test_bag as drive  # noqa: E402  (the small drive's camera and mask rendering)
+
+
+def camera_info(stamp, fx=drive.FX):
+    """The small drive's camera_info (fx overridable, e.g. NaN)."""
+    info = CameraInfo(height=drive.HEIGHT, width=drive.WIDTH, distortion_model="plumb_bob",
+                      D=[0.0] * 5, K=[fx, 0, drive.CX, 0, drive.FY, drive.CY, 0, 0, 1],
+                      R=[1, 0, 0, 0, 1, 0, 0, 0, 1],
+                      P=[fx, 0, drive.CX, 0, 0, drive.FY, drive.CY, 0, 0, 0, 1, 0])
+    info.header.stamp = stamp
+    info.header.frame_id = "camera_optical"
+    return info
+
+
+def mask_image(stamp, data, encoding="16UC1"):
+    """A mask message of a numpy array (16UC1, or a 1-byte encoding such as mono8)."""
+    height, width = data.shape[:2]
+    bytes_per_pixel = 2 if encoding == "16UC1" else 1
+    image = Image(height=height, width=width, encoding=encoding, is_bigendian=0,
+                  step=width * bytes_per_pixel,
+                  data=(data.astype("<u2") if bytes_per_pixel == 2 else data.astype("u1")).tobytes())
+    image.header.stamp = stamp
+    image.header.frame_id = "camera_optical"
+    return image
+
+
+def advertised_services():
+    """Names of every service registered with the master."""
+    return [entry[0] for entry in rosgraph.Master(rospy.get_name()).getSystemState()[2]]
 
 
 def wait_for(condition, timeout_s, what, period_s=0.05):

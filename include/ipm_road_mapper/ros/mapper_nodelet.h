@@ -3,12 +3,19 @@
 // a wall timer -> MapPublisher / diagnostics, services ~save_map and ~reset. Every topic,
 // parameter, service and frame is listed in docs/ros_api.md.
 //
-// Threading: data callbacks (masks + camera_info, odometry) run on the nodelet's
-// single-threaded queue; the publish timer, the diagnostics timer and the services on its
-// multi-threaded queue. `mutex_` guards the session (Mapper + FrameAssembler, neither is
-// thread-safe) and the state next to it; ExportMap is the only map copy made under it, and
-// nothing is published while it is held. The Mapper's optimizer is its own thread: no
-// callback waits for it (only the shutdown save does, in Mapper::Finish).
+// Threading: data callbacks (masks + camera_info, odometry, the debug image) run on the
+// nodelet's single-threaded queue; the publish and diagnostics timers and the services on
+// `output_queue_`, a queue this object owns, served by its own spinner thread. `mutex_`
+// guards the session (Mapper + FrameAssembler, neither is thread-safe) and the state next
+// to it; ExportMap is the only map copy made under it, and nothing is published while it
+// is held. The Mapper's optimizer is its own thread: no callback waits for it (only the
+// shutdown save does, in Mapper::Finish).
+// Why not the nodelet's multi-threaded queue: nodelet's queues hold the nodelet through a
+// weak_ptr locked per callback, so an unload during a data callback destroys the nodelet at
+// the end of that callback, in a worker thread, when its other queue may already be freed;
+// stopping a timer registered there then touches freed memory (a manager segfault that
+// test/ros/mapper_reload.test caught). Every queue our handles point to must outlive them:
+// the running single-threaded queue does, and so does our own.
 #pragma once
 
 #include <message_filters/subscriber.h>
@@ -17,7 +24,9 @@
 #include <message_filters/synchronizer.h>
 #include <nav_msgs/Odometry.h>
 #include <nodelet/nodelet.h>
+#include <ros/callback_queue.h>
 #include <ros/ros.h>
+#include <ros/spinner.h>
 #include <sensor_msgs/CameraInfo.h>
 #include <sensor_msgs/Image.h>
 #include <std_srvs/Trigger.h>
@@ -95,6 +104,9 @@ class MapperNodelet : public nodelet::Nodelet {
   double callback_total_ms_ = 0.0, callback_max_ms_ = 0.0;
   bool shutting_down_ = false;
 
+  // Declared before every handle that uses it, so it is destroyed after them.
+  ros::CallbackQueue output_queue_;
+  std::unique_ptr<ros::AsyncSpinner> output_spinner_;
   std::unique_ptr<tf2_ros::Buffer> tf_buffer_;
   std::unique_ptr<tf2_ros::TransformListener> tf_listener_;
   // Subscribers before the synchronizers: the synchronizers disconnect from them when
