@@ -50,6 +50,10 @@ cv::Point ToCv(const Eigen::Vector2d& uv) {
   return cv::Point(static_cast<int>(std::lround(uv.x())), static_cast<int>(std::lround(uv.y())));
 }
 
+// Line width that stays visible when the image is shown scaled down (rviz's image panel).
+int Thickness(const cv::Mat& canvas) { return std::max(2, canvas.cols / 400); }
+int ThinThickness(const cv::Mat& canvas) { return std::max(1, Thickness(canvas) - 1); }
+
 cv::Mat Background(const OverlayFrame& frame) {
   const cv::Size size(frame.camera.width, frame.camera.height);
   cv::Mat canvas;
@@ -96,8 +100,8 @@ void DrawMarkings(const VectorMap& map, const FrameProjector& projector,
       ok = projector.Project(marking.corners_map[i], &p.corners_uv[i]);
     if (!ok) continue;
     for (int i = 0; i < 4; ++i) {
-      cv::line(*canvas, ToCv(p.corners_uv[i]), ToCv(p.corners_uv[(i + 1) % 4]), kMapColor, 2,
-               cv::LINE_AA);
+      cv::line(*canvas, ToCv(p.corners_uv[i]), ToCv(p.corners_uv[(i + 1) % 4]), kMapColor,
+               Thickness(*canvas), cv::LINE_AA);
     }
     projected->push_back(p);
   }
@@ -120,7 +124,9 @@ void DrawLanes(const VectorMap& map, const FrameProjector& projector,
         line.clear();
         continue;
       }
-      if (!line.empty()) cv::line(*canvas, ToCv(line.back()), ToCv(uv), kMapColor, 2, cv::LINE_AA);
+      if (!line.empty()) {
+        cv::line(*canvas, ToCv(line.back()), ToCv(uv), kMapColor, Thickness(*canvas), cv::LINE_AA);
+      }
       line.push_back(uv);
     }
     if (line.size() >= 2) lanes->push_back(line);
@@ -137,8 +143,9 @@ void DrawMeasuredMarkings(const FrameObservations& measured,
     ++stats->markings_measured;
     for (int i = 0; i < 4; ++i) {
       cv::line(*canvas, ToCv(obs.corners_uv[i]), ToCv(obs.corners_uv[(i + 1) % 4]), kMeasuredColor,
-               1, cv::LINE_AA);
-      cv::circle(*canvas, ToCv(obs.corners_uv[i]), 4, kMeasuredColor, -1, cv::LINE_AA);
+               ThinThickness(*canvas), cv::LINE_AA);
+      cv::circle(*canvas, ToCv(obs.corners_uv[i]), Thickness(*canvas) + 2, kMeasuredColor, -1,
+                 cv::LINE_AA);
     }
     Eigen::Vector3d center_base = Eigen::Vector3d::Zero();
     for (const Eigen::Vector3d& c : obs.corners_base) center_base += 0.25 * c;
@@ -159,8 +166,9 @@ void DrawMeasuredMarkings(const FrameObservations& measured,
     double best_sum = std::numeric_limits<double>::infinity();
     for (int shift = 0; shift < 4; ++shift) {
       double sum = 0.0;
-      for (int i = 0; i < 4; ++i)
+      for (int i = 0; i < 4; ++i) {
         sum += (obs.corners_uv[i] - best->corners_uv[(i + shift) % 4]).norm();
+      }
       if (sum < best_sum) {
         best_sum = sum;
         best_shift = shift;
@@ -168,7 +176,7 @@ void DrawMeasuredMarkings(const FrameObservations& measured,
     }
     for (int i = 0; i < 4; ++i) {
       cv::line(*canvas, ToCv(obs.corners_uv[i]), ToCv(best->corners_uv[(i + best_shift) % 4]),
-               kResidualColor, 1, cv::LINE_AA);
+               kResidualColor, ThinThickness(*canvas), cv::LINE_AA);
     }
     ++stats->marking_matches;
     residual_sum += best_sum;
@@ -184,7 +192,7 @@ void DrawMeasuredLanes(const FrameObservations& measured, const std::vector<Poly
   for (const LaneObservation& obs : measured.lanes) {
     for (const LanePoint& point : obs.points) {
       ++stats->lane_points_measured;
-      cv::circle(*canvas, ToCv(point.uv), 3, kMeasuredColor, -1, cv::LINE_AA);
+      cv::circle(*canvas, ToCv(point.uv), Thickness(*canvas) + 1, kMeasuredColor, -1, cv::LINE_AA);
       double best = kLaneMatchGatePx;
       Eigen::Vector2d best_point = point.uv;
       for (const Polyline& line : lanes) {
@@ -202,7 +210,8 @@ void DrawMeasuredLanes(const FrameObservations& measured, const std::vector<Poly
         }
       }
       if (best < kLaneMatchGatePx) {
-        cv::line(*canvas, ToCv(point.uv), ToCv(best_point), kResidualColor, 1, cv::LINE_AA);
+        cv::line(*canvas, ToCv(point.uv), ToCv(best_point), kResidualColor, ThinThickness(*canvas),
+                 cv::LINE_AA);
         ++stats->lane_point_matches;
         residual_sum += best;
       }
@@ -214,13 +223,13 @@ void DrawMeasuredLanes(const FrameObservations& measured, const std::vector<Poly
 }
 
 void DrawLegend(const OverlayStats& stats, cv::Mat* canvas) {
-  const double scale = std::max(0.5, canvas->cols / 1600.0);
-  const int step = static_cast<int>(26 * scale);
+  const double scale = std::max(0.6, canvas->cols / 1000.0);
+  const int step = static_cast<int>(30 * scale);
   auto text = [&](int row, const std::string& s, const cv::Scalar& color) {
-    cv::putText(*canvas, s, cv::Point(10, step * (row + 1)), cv::FONT_HERSHEY_SIMPLEX, 0.7 * scale,
-                cv::Scalar(0, 0, 0), 4, cv::LINE_AA);
-    cv::putText(*canvas, s, cv::Point(10, step * (row + 1)), cv::FONT_HERSHEY_SIMPLEX, 0.7 * scale,
-                color, 1, cv::LINE_AA);
+    const cv::Point at(10, step * (row + 1));
+    cv::putText(*canvas, s, at, cv::FONT_HERSHEY_SIMPLEX, 0.7 * scale, cv::Scalar(0, 0, 0), 5,
+                cv::LINE_AA);
+    cv::putText(*canvas, s, at, cv::FONT_HERSHEY_SIMPLEX, 0.7 * scale, color, 2, cv::LINE_AA);
   };
   char line[160];
   std::snprintf(line, sizeof(line), "map projection: %d markings, %d lane pieces",

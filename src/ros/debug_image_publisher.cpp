@@ -91,15 +91,11 @@ void DebugImagePublisher::OnConnection() {
   old.shutdown();
 }
 
-void DebugImagePublisher::SetMap(std::shared_ptr<const VectorMap> map) {
-  std::lock_guard<std::mutex> lock(mutex_);
-  map_ = std::move(map);
-}
-
 void DebugImagePublisher::AddFrame(const FrameInput& frame, const Eigen::Isometry3d& T_map_base,
-                                   const Eigen::Isometry3d& T_base_cam) {
-  if (!active()) return;
-  PendingFrame job{frame, T_map_base, T_base_cam};
+                                   const Eigen::Isometry3d& T_base_cam,
+                                   std::shared_ptr<const VectorMap> map) {
+  if (!active() || !map) return;
+  PendingFrame job{frame, T_map_base, T_base_cam, std::move(map)};
   sensor_msgs::ImageConstPtr image;
   {
     std::lock_guard<std::mutex> lock(mutex_);
@@ -132,12 +128,10 @@ void DebugImagePublisher::OnImage(const sensor_msgs::ImageConstPtr& image) {
 }
 
 void DebugImagePublisher::Draw(const PendingFrame& job, const sensor_msgs::ImageConstPtr& image) {
-  std::shared_ptr<const VectorMap> map;
   ros::Publisher pub;
   {
     std::lock_guard<std::mutex> lock(mutex_);
     if (shut_down_) return;
-    map = map_;
     pub = pub_;
   }
   OverlayFrame frame;
@@ -148,7 +142,7 @@ void DebugImagePublisher::Draw(const PendingFrame& job, const sensor_msgs::Image
   frame.T_map_base = job.T_map_base;
   const FrameObservations measured =
       MeasureFrame(job.frame.mask, job.frame.camera, job.T_base_cam, classes_, options_);
-  const cv::Mat overlay = DrawDebugOverlay(frame, measured, map ? *map : VectorMap());
+  const cv::Mat overlay = DrawDebugOverlay(frame, measured, *job.map);
   std_msgs::Header header;
   header.stamp = FromSeconds(job.frame.stamp);
   header.frame_id = image ? image->header.frame_id : "";

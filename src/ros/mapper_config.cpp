@@ -39,6 +39,7 @@ RosOptions LoadRosOptions(OptionsReader reader) {
   reader.Read<double>("odometry_wait_s", &o.odometry_wait_s, CheckNonNegative);
   reader.Read<int>("path_max_poses", &o.path_max_poses, CheckPositiveInt);
   reader.Read<double>("diagnostics_period_s", &o.diagnostics_period_s, CheckPositive);
+  reader.Read<double>("debug_image_rate_hz", &o.debug_image_rate_hz, CheckPositive);
   reader.RejectUnknownKeys();
   return o;
 }
@@ -78,7 +79,8 @@ std::string ToString(const RosOptions& o) {
     << "ros.odom_queue_size: " << o.odom_queue_size << "\n"
     << "ros.odometry_wait_s: " << o.odometry_wait_s << "\n"
     << "ros.path_max_poses: " << o.path_max_poses << "\n"
-    << "ros.diagnostics_period_s: " << o.diagnostics_period_s << "\n";
+    << "ros.diagnostics_period_s: " << o.diagnostics_period_s << "\n"
+    << "ros.debug_image_rate_hz: " << o.debug_image_rate_hz << "\n";
   return s.str();
 }
 

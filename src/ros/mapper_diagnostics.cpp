@@ -68,6 +68,8 @@ void FillFrameStatus(const MapperStatusSnapshot& now, const MapperStatusSnapshot
   s->add("time jumps", now.assembler.time_jumps);
   s->addf("callback time mean (ms)", "%.2f", now.callback_mean_ms);
   s->addf("callback time max (ms)", "%.2f", now.callback_max_ms);
+  s->addf("frame callback time mean (ms)", "%.2f", now.frame_callback_mean_ms);
+  s->addf("frame callback time max (ms)", "%.2f", now.frame_callback_max_ms);
   const std::uint64_t new_used = used - std::min(used, previous.counters.frames_used);
   const std::uint64_t new_skipped =
       skipped_total - std::min(skipped_total, Total(AllSkipped(previous)));

@@ -163,7 +163,7 @@ void MapperNodelet::OnFrame(const sensor_msgs::ImageConstPtr& mask_msg,
     outputs = CollectLocked(update);
   }
   AfterUpdate(update, outputs);
-  RecordCallbackTime(start);
+  RecordCallbackTime(start, update.used.size());
 }
 
 void MapperNodelet::OnOdometry(const nav_msgs::OdometryConstPtr& msg) {
@@ -191,7 +191,7 @@ void MapperNodelet::OnOdometry(const nav_msgs::OdometryConstPtr& msg) {
     outputs = CollectLocked(update);
   }
   AfterUpdate(update, outputs);
-  RecordCallbackTime(start);
+  RecordCallbackTime(start, update.used.size());
 }
 
 MapperNodelet::UpdateOutputs MapperNodelet::CollectLocked(const SessionUpdate& update) {
@@ -202,6 +202,16 @@ MapperNodelet::UpdateOutputs MapperNodelet::CollectLocked(const SessionUpdate& u
     outputs.T_base_cam = mapper.T_base_cam();
     last_frame_stamp_ = update.used.back().stamp;
     ++changes_;
+    // The overlay draws the map as of its frame: one export, throttled, only when watched.
+    const auto now = std::chrono::steady_clock::now();
+    if (debug_image_ && debug_image_->active() &&
+        std::chrono::duration<double>(now - last_overlay_).count() >=
+            1.0 / config_.ros.debug_image_rate_hz) {
+      last_overlay_ = now;
+      if (std::optional<VectorMap> map = ExportLocked()) {
+        outputs.overlay_map = std::make_shared<const VectorMap>(std::move(*map));
+      }
+    }
   }
   outputs.map_frame = map_frame_.empty() ? "map" : map_frame_;
   outputs.base_frame = config_.mapper.input.base_frame;
@@ -219,17 +229,25 @@ void MapperNodelet::AfterUpdate(const SessionUpdate& update, const UpdateOutputs
   odom.child_frame_id = outputs.base_frame;
   odom.pose.pose = IsometryToPose(outputs.T_map_base);
   corrected_odom_pub_.publish(odom);
-  if (debug_image_)
-    debug_image_->AddFrame(update.used.back(), outputs.T_map_base, outputs.T_base_cam);
+  if (debug_image_ && outputs.overlay_map) {
+    debug_image_->AddFrame(update.used.back(), outputs.T_map_base, outputs.T_base_cam,
+                           outputs.overlay_map);
+  }
 }
 
-void MapperNodelet::RecordCallbackTime(std::chrono::steady_clock::time_point start) {
+void MapperNodelet::RecordCallbackTime(std::chrono::steady_clock::time_point start,
+                                       std::size_t used_frames) {
   const double ms =
       std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - start).count();
   std::lock_guard<std::mutex> lock(mutex_);
   ++callbacks_;
   callback_total_ms_ += ms;
   callback_max_ms_ = std::max(callback_max_ms_, ms);
+  if (used_frames > 0) {
+    ++frame_callbacks_;
+    frame_callback_total_ms_ += ms;
+    frame_callback_max_ms_ = std::max(frame_callback_max_ms_, ms);
+  }
 }
 
 std::optional<VectorMap> MapperNodelet::ExportLocked() const {
@@ -257,7 +275,6 @@ void MapperNodelet::OnPublishTimer() {
     stamp = FromSeconds(last_frame_stamp_);
   }
   map_publisher_->Publish(*map, map->frame_id, base_frame, refined_frame, stamp);
-  debug_image_->SetMap(map);
 }
 
 bool MapperNodelet::OnSaveMap(ipm_road_mapper::SaveMap::Request& request,
@@ -304,7 +321,6 @@ bool MapperNodelet::OnReset(std_srvs::Trigger::Request&, std_srvs::Trigger::Resp
     map_frame = map_frame_.empty() ? "map" : map_frame_;
   }
   map_publisher_->Clear(map_frame, ros::Time::now());
-  debug_image_->SetMap(nullptr);
   response.success = true;
   response.message = "map, waiting frames and odometry cleared";
   NODELET_INFO("reset: %s", response.message.c_str());
@@ -329,6 +345,8 @@ MapperStatusSnapshot MapperNodelet::Snapshot() {
   s.callbacks = callbacks_;
   s.callback_mean_ms = callbacks_ ? callback_total_ms_ / callbacks_ : 0.0;
   s.callback_max_ms = callback_max_ms_;
+  s.frame_callback_mean_ms = frame_callbacks_ ? frame_callback_total_ms_ / frame_callbacks_ : 0.0;
+  s.frame_callback_max_ms = frame_callback_max_ms_;
   return s;
 }
 
@@ -356,9 +374,14 @@ void MapperNodelet::Shutdown() {
       final_map = ExportLocked();
     }
     if (callbacks_ > 0) {
-      NODELET_INFO("%s: %lu data callbacks, %.2f ms mean, %.2f ms max", node_name_.c_str(),
-                   static_cast<unsigned long>(callbacks_), callback_total_ms_ / callbacks_,
-                   callback_max_ms_);
+      NODELET_INFO(
+          "%s: %lu data callbacks, %.2f ms mean, %.2f ms max; %lu ran frames through "
+          "the mapper, %.2f ms mean, %.2f ms max",
+          node_name_.c_str(), static_cast<unsigned long>(callbacks_),
+          callback_total_ms_ / callbacks_, callback_max_ms_,
+          static_cast<unsigned long>(frame_callbacks_),
+          frame_callbacks_ ? frame_callback_total_ms_ / frame_callbacks_ : 0.0,
+          frame_callback_max_ms_);
     }
   }
   if (final_map) {

@@ -33,12 +33,9 @@ class DebugImagePublisher {
   // True while someone subscribes to ~debug_image.
   bool active() const;
 
-  // The newest published map snapshot (drawn into every overlay until the next one).
-  void SetMap(std::shared_ptr<const VectorMap> map);
-
-  // A frame the mapper used, with its corrected pose and the extrinsic after it.
+  // A frame the mapper used, with its corrected pose, the extrinsic and the map after it.
   void AddFrame(const FrameInput& frame, const Eigen::Isometry3d& T_map_base,
-                const Eigen::Isometry3d& T_base_cam);
+                const Eigen::Isometry3d& T_base_cam, std::shared_ptr<const VectorMap> map);
 
   // Unsubscribes and stops drawing (before the nodelet goes away).
   void Shutdown();
@@ -48,6 +45,7 @@ class DebugImagePublisher {
     FrameInput frame;
     Eigen::Isometry3d T_map_base;
     Eigen::Isometry3d T_base_cam;
+    std::shared_ptr<const VectorMap> map;
   };
   void OnConnection();
   void OnImage(const sensor_msgs::ImageConstPtr& image);
@@ -61,7 +59,6 @@ class DebugImagePublisher {
   ros::Publisher pub_;
   ros::Subscriber image_sub_;
   bool shut_down_ = false;
-  std::shared_ptr<const VectorMap> map_;
   std::deque<sensor_msgs::ImageConstPtr> images_;  // newest last
   std::optional<PendingFrame> pending_;
   ros::WallTime last_image_wall_;

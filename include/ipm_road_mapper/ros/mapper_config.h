@@ -29,6 +29,9 @@ struct RosOptions {
   // missing odometry shows in the counters without waiting for the queue to overflow.
   double odometry_wait_s = 1.0;
   int path_max_poses = 5000;  // ~corrected_path keeps the newest this many poses
+  // ~debug_image at most this often; each overlay exports the map as of its frame (only
+  // while someone subscribes).
+  double debug_image_rate_hz = 5.0;
   double diagnostics_period_s = 1.0;
 };
 

@@ -48,8 +48,9 @@ struct MapperStatusSnapshot {
   BackendStats backend;
   Eigen::Isometry3d T_base_cam_initial = Eigen::Isometry3d::Identity();
   Eigen::Isometry3d T_base_cam = Eigen::Isometry3d::Identity();
-  std::uint64_t callbacks = 0;  // data callbacks timed
-  double callback_mean_ms = 0.0, callback_max_ms = 0.0;
+  std::uint64_t callbacks = 0;                                       // data callbacks timed
+  double callback_mean_ms = 0.0, callback_max_ms = 0.0;              // every data callback
+  double frame_callback_mean_ms = 0.0, frame_callback_max_ms = 0.0;  // those that used frames
 };
 
 // The four statuses (see the file comment). `previous` is the snapshot of the last update,

@@ -75,12 +75,14 @@ class MapperNodelet : public nodelet::Nodelet {
     Eigen::Isometry3d T_map_base = Eigen::Isometry3d::Identity();  // newest used frame
     Eigen::Isometry3d T_base_cam = Eigen::Isometry3d::Identity();
     std::string map_frame, base_frame;
+    std::shared_ptr<const VectorMap> overlay_map;  // set when a debug overlay is due
   };
   // Under mutex_: notes a change and copies the newest used frame's pose and the extrinsic.
   UpdateOutputs CollectLocked(const SessionUpdate& update);
   // Outside mutex_: skip warnings, ~corrected_odom and the debug overlay of a used frame.
   void AfterUpdate(const SessionUpdate& update, const UpdateOutputs& outputs);
-  void RecordCallbackTime(std::chrono::steady_clock::time_point start);
+  // Wall time of one data callback; `used_frames`: frames it ran through the Mapper.
+  void RecordCallbackTime(std::chrono::steady_clock::time_point start, std::size_t used_frames);
 
   void OnPublishTimer();
   bool OnSaveMap(ipm_road_mapper::SaveMap::Request& request,
@@ -100,9 +102,11 @@ class MapperNodelet : public nodelet::Nodelet {
   std::string camera_frame_, refined_frame_, map_frame_, extrinsic_status_;
   std::uint64_t changes_ = 0, published_changes_ = 0;
   double last_frame_stamp_ = 0.0;
-  std::uint64_t callbacks_ = 0;
+  std::uint64_t callbacks_ = 0, frame_callbacks_ = 0;
   double callback_total_ms_ = 0.0, callback_max_ms_ = 0.0;
+  double frame_callback_total_ms_ = 0.0, frame_callback_max_ms_ = 0.0;
   bool shutting_down_ = false;
+  std::chrono::steady_clock::time_point last_overlay_;
 
   // Declared before every handle that uses it, so it is destroyed after them.
   ros::CallbackQueue output_queue_;
