@@ -58,10 +58,9 @@ void FillFrameStatus(const MapperStatusSnapshot& now, const MapperStatusSnapshot
   s->add("frames skipped", skipped_total);
   for (const auto& [reason, count] : skipped) s->add("skipped: " + reason, count);
   s->add("masks dropped by the sync (no camera_info)", masks > pairs ? masks - pairs : 0);
-  s->add("frames waiting for odometry", now.started ? now.assembler.frames_received -
-                                                          now.assembler.frames_ready -
-                                                          Total(now.assembler.frames_skipped)
-                                                    : 0);
+  const std::uint64_t decided = now.assembler.frames_ready + Total(now.assembler.frames_skipped);
+  s->add("frames waiting for odometry",
+         now.assembler.frames_received > decided ? now.assembler.frames_received - decided : 0);
   s->add("odometry used", now.assembler.odometry_used);
   s->add("odometry bad", now.assembler.bad_odometry);
   s->add("odometry out of order", now.assembler.odometry_out_of_order);

@@ -6,6 +6,7 @@
 #include <vector>
 
 #include "ipm_road_mapper/core/catmull_rom_spline.h"
+#include "ipm_road_mapper/ros/msg_conversion.h"
 
 namespace ipm_road_mapper {
 namespace {
@@ -25,14 +26,6 @@ std_msgs::ColorRGBA Rgba(float r, float g, float b, float a = 1.0f) {
 }
 
 int MarkerId(std::uint64_t element_id) { return static_cast<int>(element_id & 0x7fffffffu); }
-
-geometry_msgs::Point ToPoint(const Eigen::Vector3d& p) {
-  geometry_msgs::Point msg;
-  msg.x = p.x();
-  msg.y = p.y();
-  msg.z = p.z();
-  return msg;
-}
 
 visualization_msgs::Marker NewMarker(const std::string& ns, int id, int type,
                                      const std::string& frame_id, const ros::Time& stamp) {
@@ -99,14 +92,14 @@ visualization_msgs::MarkerArray MarkerBuilder::Build(const VectorMap& map,
     line.scale.x = 0.15;  // line width, m (a painted lane line)
     line.color = color;
     for (const Eigen::Vector3d& p : LaneSamples(lane, lane_sample_spacing_m_)) {
-      line.points.push_back(ToPoint(p));
+      line.points.push_back(ToPointMsg(p));
     }
     if (line.points.size() >= 2) add(line);
     Marker points =
         NewMarker(kControlPointNs, MarkerId(lane.id), Marker::SPHERE_LIST, frame_id, stamp);
     points.scale.x = points.scale.y = points.scale.z = 0.3;
     points.color = Rgba(color.r * 0.6f, color.g * 0.6f, color.b * 0.6f + 0.4f);
-    for (const Eigen::Vector3d& c : lane.control_points_map) points.points.push_back(ToPoint(c));
+    for (const Eigen::Vector3d& c : lane.control_points_map) points.points.push_back(ToPointMsg(c));
     if (!points.points.empty()) add(points);
   }
   for (const MapMarking& marking : map.markings) {
@@ -115,11 +108,11 @@ visualization_msgs::MarkerArray MarkerBuilder::Build(const VectorMap& map,
         NewMarker(kMarkingNs, MarkerId(marking.id), Marker::LINE_STRIP, frame_id, stamp);
     outline.scale.x = 0.08;
     outline.color = color;
-    for (int i = 0; i <= 4; ++i) outline.points.push_back(ToPoint(marking.corners_map[i % 4]));
+    for (int i = 0; i <= 4; ++i) outline.points.push_back(ToPointMsg(marking.corners_map[i % 4]));
     add(outline);
     Marker label =
         NewMarker(kLabelNs, MarkerId(marking.id), Marker::TEXT_VIEW_FACING, frame_id, stamp);
-    label.pose.position = ToPoint(marking.Center() + Eigen::Vector3d(0.0, 0.0, 0.5));
+    label.pose.position = ToPointMsg(marking.Center() + Eigen::Vector3d(0.0, 0.0, 0.5));
     label.scale.z = 0.6;  // text height, m
     label.color = color;
     label.text = marking.class_name.empty() ? "class " + std::to_string(marking.class_id)

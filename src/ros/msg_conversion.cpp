@@ -28,6 +28,14 @@ bool HostIsBigEndian() {
 
 }  // namespace
 
+geometry_msgs::Point ToPointMsg(const Eigen::Vector3d& p) {
+  geometry_msgs::Point msg;
+  msg.x = p.x();
+  msg.y = p.y();
+  msg.z = p.z();
+  return msg;
+}
+
 std::string CameraInfoToIntrinsics(const sensor_msgs::CameraInfo& msg,
                                    CameraIntrinsics* intrinsics) {
   const std::string& model = msg.distortion_model;

@@ -7,16 +7,6 @@
 namespace ipm_road_mapper {
 namespace {
 
-geometry_msgs::Point ToPoint(const Eigen::Vector3d& p) {
-  geometry_msgs::Point msg;
-  msg.x = p.x();
-  msg.y = p.y();
-  msg.z = p.z();
-  return msg;
-}
-
-Eigen::Vector3d FromPoint(const geometry_msgs::Point& p) { return {p.x, p.y, p.z}; }
-
 // A stamp that ros::Time accepts (it throws on negative or out-of-range seconds).
 ros::Time SafeTime(double seconds) {
   if (!(seconds >= 0.0) || seconds > 4294967295.0) return ros::Time(0);
@@ -36,7 +26,7 @@ ipm_road_mapper::VectorMapMsg ToVectorMapMsg(const VectorMap& map, const std::st
     m.id = marking.id;
     m.class_id = marking.class_id;
     m.class_name = marking.class_name;
-    for (int i = 0; i < 4; ++i) m.corners[i] = ToPoint(marking.corners_map[i]);
+    for (int i = 0; i < 4; ++i) m.corners[i] = ToPointMsg(marking.corners_map[i]);
     m.observations = marking.observations;
     m.first_seen = SafeTime(marking.first_seen);
     m.last_seen = SafeTime(marking.last_seen);
@@ -49,7 +39,8 @@ ipm_road_mapper::VectorMapMsg ToVectorMapMsg(const VectorMap& map, const std::st
     l.class_id = lane.class_id;
     l.class_name = lane.class_name;
     l.style = lane.style.empty() ? "unknown" : lane.style;
-    for (const Eigen::Vector3d& c : lane.control_points_map) l.control_points.push_back(ToPoint(c));
+    for (const Eigen::Vector3d& c : lane.control_points_map)
+      l.control_points.push_back(ToPointMsg(c));
     l.observations = lane.observations;
     l.first_seen = SafeTime(lane.first_seen);
     l.last_seen = SafeTime(lane.last_seen);
@@ -67,7 +58,7 @@ VectorMap FromVectorMapMsg(const ipm_road_mapper::VectorMapMsg& msg) {
     marking.id = m.id;
     marking.class_id = m.class_id;
     marking.class_name = m.class_name;
-    for (int i = 0; i < 4; ++i) marking.corners_map[i] = FromPoint(m.corners[i]);
+    for (int i = 0; i < 4; ++i) marking.corners_map[i] = FromPointMsg(m.corners[i]);
     marking.observations = m.observations;
     marking.first_seen = ToSeconds(m.first_seen);
     marking.last_seen = ToSeconds(m.last_seen);
@@ -79,7 +70,7 @@ VectorMap FromVectorMapMsg(const ipm_road_mapper::VectorMapMsg& msg) {
     lane.class_id = l.class_id;
     lane.class_name = l.class_name;
     lane.style = l.style == "unknown" ? "" : l.style;
-    for (const auto& c : l.control_points) lane.control_points_map.push_back(FromPoint(c));
+    for (const auto& c : l.control_points) lane.control_points_map.push_back(FromPointMsg(c));
     lane.observations = l.observations;
     lane.first_seen = ToSeconds(l.first_seen);
     lane.last_seen = ToSeconds(l.last_seen);

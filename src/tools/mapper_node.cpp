@@ -1,6 +1,6 @@
 // Runs MapperNodelet as a standalone node, for users who do not run a nodelet manager:
 //
-//   rosparam load config/mapper.yaml /ipm_road_mapper
+//   rosparam load config/mapper.yaml /ipm_road_mapper   (and config/ros.yaml, optional)
 //   rosrun ipm_road_mapper mapper_node [__name:=<name>]
 //
 // Parameters, topics and services are those of the nodelet (docs/ros_api.md), in the

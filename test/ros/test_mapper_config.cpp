@@ -25,16 +25,23 @@ std::string ErrorOf(const std::string& yaml) {
   return "";
 }
 
-TEST(MapperConfig, PackageConfigLoadsWithItsRosSection) {
-  const MapperConfig config =
-      LoadMapperConfigFile(std::string(IRM_SOURCE_DIR) + "/config/mapper.yaml");
-  EXPECT_DOUBLE_EQ(config.ros.publish_rate_hz, 2.0);
-  EXPECT_EQ(config.ros.map_frame, "");
-  EXPECT_EQ(config.ros.sync_queue_size, 10);
+TEST(MapperConfig, PackageConfigsLoadAndRosYamlStatesTheDefaults) {
+  const std::string dir = std::string(IRM_SOURCE_DIR) + "/config/";
+  const MapperConfig config = LoadMapperConfigFile(dir + "mapper.yaml");
   EXPECT_EQ(config.mapper.input.sync, "exact");
   EXPECT_FALSE(config.geo_origin.has_value());
   // The ablation configs overlay it (base:) and load as well.
-  EXPECT_NO_THROW(LoadMapperConfigFile(std::string(IRM_SOURCE_DIR) + "/config/ablations/ipm.yaml"));
+  EXPECT_NO_THROW(LoadMapperConfigFile(dir + "ablations/ipm.yaml"));
+  // config/ros.yaml (loaded by mapper.launch) holds exactly the struct's defaults.
+  const RosOptions defaults;
+  const RosOptions file = LoadRosOptions(OptionsReader::FromFile(dir + "ros.yaml").Child("ros"));
+  EXPECT_EQ(ToString(file), ToString(defaults));
+  EXPECT_DOUBLE_EQ(file.publish_rate_hz, 2.0);
+  EXPECT_EQ(file.sync_queue_size, 10);
+  // Both in one tree load too (what the nodelet's private namespace holds).
+  YAML::Node both = YAML::LoadFile(dir + "mapper.yaml");
+  both["ros"] = YAML::LoadFile(dir + "ros.yaml")["ros"];
+  EXPECT_DOUBLE_EQ(LoadMapperConfig(OptionsReader(both, "")).ros.debug_image_rate_hz, 5.0);
 }
 
 TEST(MapperConfig, RosSectionIsTypedAndValidated) {

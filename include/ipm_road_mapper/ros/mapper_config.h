@@ -14,8 +14,9 @@
 
 namespace ipm_road_mapper {
 
-// The `ros:` section: what only the live nodelet uses (the offline runner validates it too,
-// so a typo is caught wherever the file is used). Defaults are those of docs/ros_api.md.
+// The `ros:` section (config/ros.yaml): what only the live nodelet uses (the offline runner
+// validates it too when a config holds it). Defaults are those of docs/ros_api.md and of
+// config/ros.yaml (a test checks that they agree).
 struct RosOptions {
   double publish_rate_hz = 2.0;      // ~vector_map, ~markers, ~corrected_path, refined tf
   std::string map_frame;             // frame of the published map; "" = odometry header.frame_id

@@ -4,6 +4,7 @@
 // return an empty string on success and otherwise one line saying what is wrong.
 #pragma once
 
+#include <geometry_msgs/Point.h>
 #include <geometry_msgs/Pose.h>
 #include <geometry_msgs/Transform.h>
 #include <geometry_msgs/TransformStamped.h>
@@ -46,6 +47,10 @@ geometry_msgs::TransformStamped IsometryToTransformStamped(const Eigen::Isometry
                                                            const ros::Time& stamp,
                                                            const std::string& parent_frame,
                                                            const std::string& child_frame);
+
+// Eigen point <-> geometry_msgs/Point.
+geometry_msgs::Point ToPointMsg(const Eigen::Vector3d& p);
+inline Eigen::Vector3d FromPointMsg(const geometry_msgs::Point& p) { return {p.x, p.y, p.z}; }
 
 // geometry_msgs/Pose -> T (pose of the body in the reference frame).
 std::string PoseToIsometry(const geometry_msgs::Pose& msg, Eigen::Isometry3d* T);
