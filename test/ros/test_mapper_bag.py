@@ -109,7 +109,8 @@ class MapperBagTest(unittest.TestCase):
         cls.diagnostics = irm.Diagnostics()
         cls.manager = irm.Manager("/manager")
         fe_params = irm.load_config(**{"backend/enabled": False,
-                                       "ros/save_map_path": cls.out + "/live_fe/map.json"})
+                                       "ros/save_map_path": cls.out + "/live_fe/map.json",
+                                       "ros/sync_queue_size": 200})
         assert cls.manager.load("/mapper_fe", fe_params), "cannot load /mapper_fe"
         for name in ("/mapper", "/mapper_fe"):
             rospy.wait_for_service(name + "/save_map", timeout=60)
@@ -125,6 +126,8 @@ class MapperBagTest(unittest.TestCase):
         cls.frames = {name: cls.diagnostics.keys(name + ": frames")
                       for name in ("mapper", "mapper_fe")}
         cls.extrinsic = cls.diagnostics.keys("mapper: extrinsic")
+        for name, frames in cls.frames.items():
+            print("%s frames: %s" % (name, json.dumps(frames, sort_keys=True)))
         irm.wait_for(lambda: cls.topics.count.get("/mapper/debug_image", 0) > 0, 30,
                      "a debug image")
         # The published map catches up with the last frame within a publish period.
