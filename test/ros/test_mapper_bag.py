@@ -139,6 +139,11 @@ class MapperBagTest(unittest.TestCase):
         cls.save_response = save(path=cls.out + "/live_service/map.json")
         start = time.monotonic()
         cls.unloaded = {name: cls.manager.unload(name) for name in ("/mapper", "/mapper_fe")}
+        # The instances save at destruction, which nodelet may run after unload returns (at
+        # the end of a callback in flight); the save first solves the last window.
+        for stem in ("live_full", "live_fe"):
+            path = os.path.join(cls.out, stem, "map_trajectory_tum.txt")  # written last
+            irm.wait_for(lambda: os.path.isfile(path), 60, "the shutdown save of " + stem)
         cls.timings["unload"] = time.monotonic() - start
 
         fe_config = os.path.join(cls.out, "fe.yaml")

@@ -1,5 +1,6 @@
 #!/usr/bin/python3
 """rostest (c): unload and reload of the nodelet in a running manager (mapper_reload.test)."""
+import json
 import os
 import sys
 import threading
@@ -83,8 +84,12 @@ class ReloadTest(unittest.TestCase):
                 # Its services went with it.
                 irm.wait_for(lambda: name + "/save_map" not in irm.advertised_services(), 10,
                              "%s/save_map to be unadvertised" % name)
-            # The last instance saved its map on the way out.
-            self.assertTrue(os.path.isfile(save_path))
+            # The last instance saved its map on the way out. nodelet may destroy an unloaded
+            # instance only at the end of a callback in flight, after unload returned, and the
+            # save solves the last window first: wait for the file.
+            irm.wait_for(lambda: os.path.isfile(save_path), 60, "the map saved at shutdown")
+            with open(save_path) as f:
+                self.assertGreater(len(json.load(f)["trajectory"]), 0)
             # The manager is alive and takes the nodelet once more.
             self.assertTrue(manager.load("/mapper_again", params))
             rospy.wait_for_service("/mapper_again/save_map", timeout=30)
