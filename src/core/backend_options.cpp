@@ -78,6 +78,8 @@ BackendOptions LoadBackendOptions(OptionsReader reader) {
   reader.Read<double>("max_extrinsic_change_m", &o.max_extrinsic_change_m, CheckPositive);
   reader.Read<int>("max_lane_points_per_observation", &o.max_lane_points_per_observation,
                    CheckPositiveInt);
+  reader.Read<int>("max_measurements_per_marking", &o.max_measurements_per_marking,
+                   [](const int& v) { return v >= 2 ? "" : "must be >= 2"; });
   reader.Read<double>("road_height_sigma_m", &o.road_height_sigma_m, CheckPositive);
   reader.Read<double>("road_height_sigma_per_m", &o.road_height_sigma_per_m, CheckNonNegative);
   reader.Read<double>("lane_anchor_along_sigma_m", &o.lane_anchor_along_sigma_m, CheckPositive);

@@ -121,8 +121,8 @@ ExtrinsicFactor MarginalizeIntoExtrinsic(const PinholeCamera& camera, const Extr
   const double* delta = factor.delta_lin.data();
   const double inv_sigma = 1.0 / pixel_sigma_px;
   for (const MarginalizationInput::Corner& c : input.corners) {
-    ceres::AutoDiffCostFunction<CornerInChart, 2, 3, 6> cost(new CornerInChart{
-        camera, c.uv, inv_sigma, Pose(c.T_map_base), chart.q0(), chart.t0()});
+    ceres::AutoDiffCostFunction<CornerInChart, 2, 3, 6> cost(
+        new CornerInChart{camera, c.uv, inv_sigma, Pose(c.T_map_base), chart.q0(), chart.t0()});
     normal.Add(cost, {3 * c.point, delta_offset}, {input.points[c.point].data(), delta},
                huber_scale);
   }

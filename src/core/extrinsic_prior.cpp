@@ -9,8 +9,7 @@ namespace ipm_road_mapper {
 ExtrinsicPrior::ExtrinsicPrior(const Eigen::Isometry3d& T_base_cam_0,
                                const Eigen::Vector3d& sigma_rot_rad,
                                const Eigen::Vector3d& sigma_trans_m)
-    : q0_(Eigen::Quaterniond(T_base_cam_0.linear()).normalized()),
-      t0_(T_base_cam_0.translation()) {
+    : q0_(Eigen::Quaterniond(T_base_cam_0.linear()).normalized()), t0_(T_base_cam_0.translation()) {
   for (int i = 0; i < 3; ++i) {
     H_(i, i) = 1.0 / (sigma_rot_rad(i) * sigma_rot_rad(i));
     H_(3 + i, 3 + i) = 1.0 / (sigma_trans_m(i) * sigma_trans_m(i));

@@ -1,19 +1,19 @@
 // The Mapper's side of the back end: building a window snapshot, retiring the elements
 // that leave the window into the extrinsic prior, and merging results into the map.
+#include <ceres/ceres.h>
+
 #include <algorithm>
 #include <cmath>
 #include <limits>
 #include <map>
 #include <set>
 
-#include <ceres/ceres.h>
-
 #include "ipm_road_mapper/core/extrinsic_marginalization.h"
-#include "ipm_road_mapper/core/residuals/corner_reprojection_residual.h"
-#include "ipm_road_mapper/core/residuals/ground_height_prior_residual.h"
 #include "ipm_road_mapper/core/ipm.h"
 #include "ipm_road_mapper/core/mapper.h"
 #include "ipm_road_mapper/core/marking_measurement.h"
+#include "ipm_road_mapper/core/residuals/corner_reprojection_residual.h"
+#include "ipm_road_mapper/core/residuals/ground_height_prior_residual.h"
 
 namespace ipm_road_mapper {
 std::size_t Mapper::ClosestFrame(const Eigen::Vector3d& p_map) const {
@@ -35,7 +35,8 @@ void Mapper::AddRoadPrior(int point, const Eigen::Vector3d& p_map,
   const double distance = (road.T_map_base.translation() - p_map).head<2>().norm();
   const BackendOptions& o = options_.backend;
   input->road_priors.push_back(
-      {point, road.T_map_base, std::hypot(o.road_height_sigma_m, o.road_height_sigma_per_m * distance)});
+      {point, road.T_map_base,
+       std::hypot(o.road_height_sigma_m, o.road_height_sigma_per_m * distance)});
 }
 
 void Mapper::RetireMarking(MarkingElement* marking) {
@@ -53,8 +54,8 @@ void Mapper::RetireMarking(MarkingElement* marking) {
     std::array<Eigen::Vector2d, 4> corners_uv = m.corners_uv;
     if (axis.norm() > 0.0 && !m.outline_uv.empty()) {
       std::array<Eigen::Vector2d, 4> on_plane;
-      if (MeasureCornersOnPlane(camera, T_map_base * T_base_cam_, plane, axis,
-                                marking->corners_map, m.outline_uv, &on_plane)) {
+      if (MeasureCornersOnPlane(camera, T_map_base * T_base_cam_, plane, axis, marking->corners_map,
+                                m.outline_uv, &on_plane)) {
         corners_uv = on_plane;
       }
     }
@@ -120,10 +121,11 @@ void Mapper::RefineRetiredMarkings() {
         continue;
       }
       const double distance = (road.T_map_base.translation() - corners[c]).head<2>().norm();
-      problem.AddResidualBlock(residuals::GroundHeightPriorResidual::Create(
-                                   road.T_map_base, std::hypot(o.road_height_sigma_m,
-                                                               o.road_height_sigma_per_m * distance)),
-                               nullptr, corners[c].data());
+      problem.AddResidualBlock(
+          residuals::GroundHeightPriorResidual::Create(
+              road.T_map_base,
+              std::hypot(o.road_height_sigma_m, o.road_height_sigma_per_m * distance)),
+          nullptr, corners[c].data());
     }
     ceres::Solver::Options solver;
     solver.max_num_iterations = 10;
@@ -147,7 +149,8 @@ WindowSnapshot Mapper::BuildSnapshot() {
   // refine (a lane is never done, its control points are shared along it) made the prior
   // confidently wrong (0.5 deg of roll on the drive with odometry noise alone). The markings
   // carry the extrinsic's long-term information.
-  for (LaneElement& l : map_.lanes) l.retired_before_frame = std::max(l.retired_before_frame, lane_first);
+  for (LaneElement& l : map_.lanes)
+    l.retired_before_frame = std::max(l.retired_before_frame, lane_first);
 
   WindowSnapshot snapshot;
   snapshot.sequence = next_sequence_++;

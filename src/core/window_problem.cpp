@@ -118,7 +118,8 @@ std::size_t ClosestSlot(const WindowState& state, const Eigen::Vector3d& p_map) 
 // Collects the corner measurements of the window's frames, each re-measured from its
 // outline on the road plane nearest to the marking: base_link's plane of the window frame
 // closest to it (see marking_measurement.h; the flat-ground corners are the fallback).
-void CollectCornerMeasurements(const WindowSnapshot& snapshot, WindowState* state) {
+void CollectCornerMeasurements(const WindowSnapshot& snapshot, const BackendOptions& options,
+                               WindowState* state) {
   const PinholeCamera camera(snapshot.camera);
   const Eigen::Isometry3d T_base_cam = state->extrinsic.ToIsometry();
   for (std::size_t m = 0; m < snapshot.markings.size(); ++m) {
@@ -127,7 +128,20 @@ void CollectCornerMeasurements(const WindowSnapshot& snapshot, WindowState* stat
     const Eigen::Isometry3d T_map_road = state->frames[ClosestSlot(*state, center)].ToIsometry();
     const RoadPlane plane{T_map_road.translation(), T_map_road.linear().col(2)};
     const Eigen::Vector3d& axis = snapshot.markings[m].axis_map;
-    for (const MarkingMeasurement& meas : snapshot.markings[m].measurements) {
+    const auto& measurements = snapshot.markings[m].measurements;
+    // At most max_measurements_per_marking of them, spread over the history (the first and
+    // the last included): neighbouring frames see a marking almost alike.
+    const std::size_t cap = static_cast<std::size_t>(options.max_measurements_per_marking);
+    std::vector<std::size_t> chosen;
+    if (measurements.size() <= cap) {
+      for (std::size_t i = 0; i < measurements.size(); ++i) chosen.push_back(i);
+    } else {
+      for (std::size_t k = 0; k < cap; ++k) {
+        chosen.push_back(k * (measurements.size() - 1) / (cap - 1));
+      }
+    }
+    for (std::size_t i : chosen) {
+      const MarkingMeasurement& meas = measurements[i];
       const auto slot = state->slot_of_frame.find(meas.frame_index);
       if (slot == state->slot_of_frame.end()) continue;
       std::array<Eigen::Vector2d, 4> corners_uv = meas.corners_uv;
@@ -210,11 +224,11 @@ void AddRoadSurfacePrior(const BackendOptions& options, const WindowState& state
     }
   }
   const double distance = std::sqrt(best);
-  const double sigma = std::hypot(options.road_height_sigma_m,
-                                  options.road_height_sigma_per_m * distance);
-  problem->AddResidualBlock(residuals::GroundHeightPriorResidual::Create(
-                                state.frames[best_slot].ToIsometry(), sigma),
-                            nullptr, point);
+  const double sigma =
+      std::hypot(options.road_height_sigma_m, options.road_height_sigma_per_m * distance);
+  problem->AddResidualBlock(
+      residuals::GroundHeightPriorResidual::Create(state.frames[best_slot].ToIsometry(), sigma),
+      nullptr, point);
 }
 
 // Free 3D map point: z held by a subset manifold when optimize_z is off.
@@ -319,7 +333,7 @@ ceres::Solver::Summary PoseStep(const WindowSnapshot& snapshot, const BackendOpt
   const double* t_bc = state->extrinsic.t;
   *blocks = 0;
   for (const CornerMeasurement& m : state->corner_measurements) {
-    if (!snapshot.markings[m.marking].mature) continue;
+    if (!snapshot.markings[m.marking].mature || !snapshot.frames[m.slot].in_window) continue;
     PoseBlocks& pose = state->frames[m.slot];
     problem.AddResidualBlock(
         residuals::CornerReprojectionPoseStepResidual::Create(
@@ -329,13 +343,13 @@ ceres::Solver::Summary PoseStep(const WindowSnapshot& snapshot, const BackendOpt
   }
   if (options.lane_residual == LaneResidual::kPpsr) {
     for (const LanePixel& px : state->lane_pixels) {
+      if (!snapshot.frames[px.slot].in_window) continue;  // a context frame's pose is data
       const auto& cps = state->control_points[px.lane];
       PoseBlocks& pose = state->frames[px.slot];
-      problem.AddResidualBlock(
-          residuals::PpsrPoseStepResidual::Create(camera, px.uv, options.pixel_sigma_px,
-                                                  cps[px.segment + 1], cps[px.segment + 2], q_bc,
-                                                  t_bc),
-          loss, pose.q, pose.t);
+      problem.AddResidualBlock(residuals::PpsrPoseStepResidual::Create(
+                                   camera, px.uv, options.pixel_sigma_px, cps[px.segment + 1],
+                                   cps[px.segment + 2], q_bc, t_bc),
+                               loss, pose.q, pose.t);
       ++*blocks;
     }
   }
@@ -368,7 +382,7 @@ WindowResult SolveWindow(const WindowSnapshot& snapshot, const BackendOptions& o
   WindowResult result;
   result.sequence = snapshot.sequence;
   WindowState state(snapshot);
-  CollectCornerMeasurements(snapshot, &state);
+  CollectCornerMeasurements(snapshot, options, &state);
   if (options.lane_residual != LaneResidual::kNone) CollectLanePixels(snapshot, options, &state);
 
   // Map + extrinsic step, then the pose step, `rounds` times.

@@ -1,13 +1,12 @@
 // The extrinsic prior and the marginalization of retired points into it: marginalizing one
 // half of a problem and solving the other half with that prior gives the joint solution
 // (to first order), the chart round-trips, and the prior residual is the prior's cost.
-#include "ipm_road_mapper/core/extrinsic_marginalization.h"
-
 #include <ceres/ceres.h>
 #include <gtest/gtest.h>
 
 #include <random>
 
+#include "ipm_road_mapper/core/extrinsic_marginalization.h"
 #include "ipm_road_mapper/core/extrinsic_prior.h"
 #include "ipm_road_mapper/core/residuals/corner_reprojection_residual.h"
 #include "ipm_road_mapper/core/residuals/extrinsic_prior_residual.h"
@@ -107,7 +106,8 @@ Eigen::Isometry3d SolveJoint(const Scene& scene, const std::vector<int>& marking
   for (const auto& T : scene.poses) poses.push_back(Blocks(T));
   corners->assign(scene.markings.size(), {});
   for (int m : marking_ids) {
-    for (int c = 0; c < 4; ++c) (*corners)[m][c] = scene.markings[m][c] + Eigen::Vector3d(0.3, -0.1, 0.0);
+    for (int c = 0; c < 4; ++c)
+      (*corners)[m][c] = scene.markings[m][c] + Eigen::Vector3d(0.3, -0.1, 0.0);
   }
   for (const Scene::Obs& o : scene.observations) {
     if (std::find(marking_ids.begin(), marking_ids.end(), o.marking) == marking_ids.end()) continue;
@@ -177,7 +177,8 @@ TEST(MarginalizeIntoExtrinsic, HalfMarginalizedEqualsTheJointSolution) {
     }
   }
   for (const Scene::Obs& o : scene.observations) {
-    if (o.marking < 3) input.corners.push_back({4 * o.marking + o.corner, o.uv, scene.poses[o.pose]});
+    if (o.marking < 3)
+      input.corners.push_back({4 * o.marking + o.corner, o.uv, scene.poses[o.pose]});
   }
   ExtrinsicPrior prior = mounting;
   prior.Add(MarginalizeIntoExtrinsic(scene.camera, prior, T_first, input, 1.0, 0.0));

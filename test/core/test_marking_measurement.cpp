@@ -1,11 +1,10 @@
 // MeasureCornersOnPlane: exact on the marking's true plane where flat-ground IPM is biased,
 // in the reference's corner order, and false when the plane is behind the outline's rays.
-#include "ipm_road_mapper/core/marking_measurement.h"
-
 #include <gtest/gtest.h>
 
 #include <cmath>
 
+#include "ipm_road_mapper/core/marking_measurement.h"
 #include "ipm_road_mapper/core/rigid_transform.h"
 
 namespace ipm_road_mapper {
@@ -68,7 +67,8 @@ struct Scene {
   }
 };
 
-double MaxPixelError(const std::array<Eigen::Vector2d, 4>& a, const std::array<Eigen::Vector2d, 4>& b) {
+double MaxPixelError(const std::array<Eigen::Vector2d, 4>& a,
+                     const std::array<Eigen::Vector2d, 4>& b) {
   double worst = 0.0;
   for (int i = 0; i < 4; ++i) worst = std::max(worst, (a[i] - b[i]).norm());
   return worst;
@@ -91,8 +91,8 @@ TEST(MeasureCornersOnPlane, ExactOnTheTruePlaneBiasedOnTheFlatGround) {
   EXPECT_LT(MaxPixelError(measured, expected), 1e-6);
   // On base_link's flat ground (what the front end assumes) the same construction misses.
   RoadPlane flat;
-  ASSERT_TRUE(MeasureCornersOnPlane(scene.camera, scene.T_map_cam, flat, road_axis,
-                                    scene.corners, scene.outline_uv, &measured));
+  ASSERT_TRUE(MeasureCornersOnPlane(scene.camera, scene.T_map_cam, flat, road_axis, scene.corners,
+                                    scene.outline_uv, &measured));
   EXPECT_GT(MaxPixelError(measured, scene.corners_uv), 1.0);
 }
 
@@ -105,9 +105,8 @@ TEST(MeasureCornersOnPlane, FailsWhenThePlaneIsBehindTheRays) {
                                      scene.corners, scene.outline_uv, &measured));
   EXPECT_FALSE(MeasureCornersOnPlane(scene.camera, scene.T_map_cam, scene.plane, scene.axis,
                                      scene.corners, {}, &measured));
-  EXPECT_FALSE(MeasureCornersOnPlane(scene.camera, scene.T_map_cam, scene.plane,
-                                     scene.plane.normal, scene.corners, scene.outline_uv,
-                                     &measured));
+  EXPECT_FALSE(MeasureCornersOnPlane(scene.camera, scene.T_map_cam, scene.plane, scene.plane.normal,
+                                     scene.corners, scene.outline_uv, &measured));
 }
 
 }  // namespace

@@ -45,7 +45,8 @@ struct BackendOptions {
   Eigen::Vector3d pose_prior_sigma_rot_rad{0.001, 0.001, 0.0052};  // roll, pitch, yaw
   double max_extrinsic_change_rad = 2.0 * M_PI / 180.0;  // trust bound per solve
   double max_extrinsic_change_m = 0.2;
-  int max_lane_points_per_observation = 12;  // PPSR/PSR pixels per lane observation
+  int max_lane_points_per_observation = 6;  // PPSR/PSR pixels per lane observation
+  int max_measurements_per_marking = 10;    // observations of a marking per solve (spread)
   // Road-surface prior of free map points (with optimize_z): the height of a point in
   // base_link of the window frame horizontally closest to it is ~0, with sigma
   // hypot(road_height_sigma_m, road_height_sigma_per_m * distance). base_link's origin is on

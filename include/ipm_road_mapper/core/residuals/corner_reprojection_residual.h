@@ -6,14 +6,16 @@
 // parameters: all five (CornerReprojectionResidual: corner_map[3], q_map_base[4],
 // t_map_base[3], q_base_cam[4], t_base_cam[3]), the map + extrinsic step's (pose as data)
 // and the pose step's (corner and extrinsic as data), so that autodiff carries only the
-// derivatives a step needs.
+// derivatives a step needs (the step bindings analytically, projection_jacobians.h).
 #pragma once
 
 #include <ceres/autodiff_cost_function.h>
+#include <ceres/sized_cost_function.h>
 
 #include <algorithm>
 
 #include "ipm_road_mapper/core/residuals/projection.h"
+#include "ipm_road_mapper/core/residuals/projection_jacobians.h"
 
 namespace ipm_road_mapper {
 namespace residuals {
@@ -42,11 +44,10 @@ class CornerReprojectionResidual {
       : camera_(camera), uv_measured_(uv_measured), inv_sigma_(1.0 / sigma_px) {}
 
   template <typename T>
-  bool operator()(const T* const corner_map, const T* const q_map_base,
-                  const T* const t_map_base, const T* const q_base_cam,
-                  const T* const t_base_cam, T* residual) const {
-    return CornerReprojection(camera_, uv_measured_, inv_sigma_, corner_map, q_map_base,
-                              t_map_base, q_base_cam, t_base_cam, residual);
+  bool operator()(const T* const corner_map, const T* const q_map_base, const T* const t_map_base,
+                  const T* const q_base_cam, const T* const t_base_cam, T* residual) const {
+    return CornerReprojection(camera_, uv_measured_, inv_sigma_, corner_map, q_map_base, t_map_base,
+                              q_base_cam, t_base_cam, residual);
   }
 
   static ceres::CostFunction* Create(const PinholeCamera& camera, const Eigen::Vector2d& uv,
@@ -61,68 +62,103 @@ class CornerReprojectionResidual {
   double inv_sigma_;
 };
 
-// Map + extrinsic step: the frame's pose is data, so autodiff differentiates 10 parameters
-// instead of 17. Parameter blocks: corner_map[3], q_base_cam[4], t_base_cam[3].
-class CornerReprojectionMapStepResidual {
+// Map + extrinsic step: the frame's pose is data. Analytic Jacobians (projection_jacobians.h),
+// checked against the autodiffed reference binding. Parameter blocks: corner_map[3],
+// q_base_cam[4], t_base_cam[3].
+class CornerReprojectionMapStepResidual : public ceres::SizedCostFunction<2, 3, 4, 3> {
  public:
   CornerReprojectionMapStepResidual(const PinholeCamera& camera, const Eigen::Vector2d& uv,
                                     double sigma_px, const double* q_map_base,
                                     const double* t_map_base)
-      : camera_(camera), uv_measured_(uv), inv_sigma_(1.0 / sigma_px) {
-    std::copy(q_map_base, q_map_base + 4, q_map_base_);
-    std::copy(t_map_base, t_map_base + 3, t_map_base_);
-  }
+      : camera_(camera),
+        uv_measured_(uv),
+        inv_sigma_(1.0 / sigma_px),
+        R_base_map_(
+            Eigen::Map<const Eigen::Quaterniond>(q_map_base).toRotationMatrix().transpose()),
+        t_map_base_(Eigen::Map<const Eigen::Vector3d>(t_map_base)) {}
 
-  template <typename T>
-  bool operator()(const T* const corner_map, const T* const q_base_cam,
-                  const T* const t_base_cam, T* residual) const {
-    const T q[4] = {T(q_map_base_[0]), T(q_map_base_[1]), T(q_map_base_[2]), T(q_map_base_[3])};
-    const T t[3] = {T(t_map_base_[0]), T(t_map_base_[1]), T(t_map_base_[2])};
-    return CornerReprojection(camera_, uv_measured_, inv_sigma_, corner_map, q, t, q_base_cam,
-                              t_base_cam, residual);
+  bool Evaluate(double const* const* parameters, double* residuals,
+                double** jacobians) const override {
+    const Eigen::Map<const Eigen::Vector3d> corner(parameters[0]);
+    const Eigen::Matrix3d R_base_cam =
+        Eigen::Map<const Eigen::Quaterniond>(parameters[1]).toRotationMatrix();
+    const Eigen::Map<const Eigen::Vector3d> t_base_cam(parameters[2]);
+    const Eigen::Vector3d v = R_base_map_ * (corner - t_map_base_) - t_base_cam;
+    const Eigen::Matrix3d R_cam_base = R_base_cam.transpose();
+    Eigen::Vector2d uv;
+    Eigen::Matrix<double, 2, 3> J_uv;
+    if (!ProjectWithJacobian(camera_, R_cam_base * v, &uv, jacobians ? &J_uv : nullptr)) {
+      return false;
+    }
+    StoreRowMajor((uv - uv_measured_) * inv_sigma_, residuals);
+    if (!jacobians) return true;
+    const Eigen::Matrix<double, 2, 3> J_cam = inv_sigma_ * J_uv;
+    if (jacobians[0]) StoreRowMajor(J_cam * R_cam_base * R_base_map_, jacobians[0]);
+    if (jacobians[1]) {
+      StoreRowMajor(J_cam * InverseRotationJacobian(parameters[1], v), jacobians[1]);
+    }
+    if (jacobians[2]) StoreRowMajor(-J_cam * R_cam_base, jacobians[2]);
+    return true;
   }
 
   static ceres::CostFunction* Create(const PinholeCamera& camera, const Eigen::Vector2d& uv,
                                      double sigma_px, const double* q_map_base,
                                      const double* t_map_base) {
-    return new ceres::AutoDiffCostFunction<CornerReprojectionMapStepResidual, 2, 3, 4, 3>(
-        new CornerReprojectionMapStepResidual(camera, uv, sigma_px, q_map_base, t_map_base));
+    return new CornerReprojectionMapStepResidual(camera, uv, sigma_px, q_map_base, t_map_base);
   }
 
  private:
   PinholeCamera camera_;
   Eigen::Vector2d uv_measured_;
   double inv_sigma_;
-  double q_map_base_[4], t_map_base_[3];
+  Eigen::Matrix3d R_base_map_;
+  Eigen::Vector3d t_map_base_;
 };
 
-// Pose step: the corner and the extrinsic are data. Parameter blocks: q_map_base[4],
-// t_map_base[3].
-class CornerReprojectionPoseStepResidual {
+// Pose step: the corner and the extrinsic are data; analytic Jacobians. Parameter blocks:
+// q_map_base[4], t_map_base[3].
+class CornerReprojectionPoseStepResidual : public ceres::SizedCostFunction<2, 4, 3> {
  public:
   CornerReprojectionPoseStepResidual(const PinholeCamera& camera, const Eigen::Vector2d& uv,
                                      double sigma_px, const Eigen::Vector3d& corner_map,
                                      const double* q_base_cam, const double* t_base_cam)
-      : camera_(camera), uv_measured_(uv), inv_sigma_(1.0 / sigma_px), corner_map_(corner_map) {
-    std::copy(q_base_cam, q_base_cam + 4, q_base_cam_);
-    std::copy(t_base_cam, t_base_cam + 3, t_base_cam_);
-  }
+      : camera_(camera),
+        uv_measured_(uv),
+        inv_sigma_(1.0 / sigma_px),
+        corner_map_(corner_map),
+        R_cam_base_(
+            Eigen::Map<const Eigen::Quaterniond>(q_base_cam).toRotationMatrix().transpose()),
+        t_base_cam_(Eigen::Map<const Eigen::Vector3d>(t_base_cam)) {}
 
-  template <typename T>
-  bool operator()(const T* const q_map_base, const T* const t_map_base, T* residual) const {
-    const T corner[3] = {T(corner_map_(0)), T(corner_map_(1)), T(corner_map_(2))};
-    const T q[4] = {T(q_base_cam_[0]), T(q_base_cam_[1]), T(q_base_cam_[2]), T(q_base_cam_[3])};
-    const T t[3] = {T(t_base_cam_[0]), T(t_base_cam_[1]), T(t_base_cam_[2])};
-    return CornerReprojection(camera_, uv_measured_, inv_sigma_, corner, q_map_base, t_map_base,
-                              q, t, residual);
+  bool Evaluate(double const* const* parameters, double* residuals,
+                double** jacobians) const override {
+    const Eigen::Matrix3d R_map_base =
+        Eigen::Map<const Eigen::Quaterniond>(parameters[0]).toRotationMatrix();
+    const Eigen::Map<const Eigen::Vector3d> t_map_base(parameters[1]);
+    const Eigen::Vector3d v = corner_map_ - t_map_base;
+    Eigen::Vector2d uv;
+    Eigen::Matrix<double, 2, 3> J_uv;
+    if (!ProjectWithJacobian(camera_, R_cam_base_ * (R_map_base.transpose() * v - t_base_cam_), &uv,
+                             jacobians ? &J_uv : nullptr)) {
+      return false;
+    }
+    StoreRowMajor((uv - uv_measured_) * inv_sigma_, residuals);
+    if (!jacobians) return true;
+    const Eigen::Matrix<double, 2, 3> J_base = inv_sigma_ * J_uv * R_cam_base_;
+    if (jacobians[0]) {
+      StoreRowMajor(J_base * InverseRotationJacobian(parameters[0], v), jacobians[0]);
+    }
+    if (jacobians[1]) {
+      StoreRowMajor(-J_base * R_map_base.transpose(), jacobians[1]);
+    }
+    return true;
   }
 
   static ceres::CostFunction* Create(const PinholeCamera& camera, const Eigen::Vector2d& uv,
                                      double sigma_px, const Eigen::Vector3d& corner_map,
                                      const double* q_base_cam, const double* t_base_cam) {
-    return new ceres::AutoDiffCostFunction<CornerReprojectionPoseStepResidual, 2, 4, 3>(
-        new CornerReprojectionPoseStepResidual(camera, uv, sigma_px, corner_map, q_base_cam,
-                                               t_base_cam));
+    return new CornerReprojectionPoseStepResidual(camera, uv, sigma_px, corner_map, q_base_cam,
+                                                  t_base_cam);
   }
 
  private:
@@ -130,7 +166,8 @@ class CornerReprojectionPoseStepResidual {
   Eigen::Vector2d uv_measured_;
   double inv_sigma_;
   Eigen::Vector3d corner_map_;
-  double q_base_cam_[4], t_base_cam_[3];
+  Eigen::Matrix3d R_cam_base_;
+  Eigen::Vector3d t_base_cam_;
 };
 
 }  // namespace residuals

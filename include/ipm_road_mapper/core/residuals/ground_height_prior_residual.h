@@ -24,8 +24,8 @@ class GroundHeightPriorResidual {
 
   template <typename T>
   bool operator()(const T* const p_map, T* residual) const {
-    const T z_base = T(row_(0)) * p_map[0] + T(row_(1)) * p_map[1] + T(row_(2)) * p_map[2] -
-                     T(offset_);
+    const T z_base =
+        T(row_(0)) * p_map[0] + T(row_(1)) * p_map[1] + T(row_(2)) * p_map[2] - T(offset_);
     residual[0] = z_base * T(inv_sigma_);
     return true;
   }

@@ -8,14 +8,17 @@
 // vector has rank 1 (it lies along the segment's normal), which Ceres handles fine.
 // One function computes it; the bindings choose the parameters: all six blocks
 // (PpsrResidual: c1[3], c2[3], q_map_base[4], t_map_base[3], q_base_cam[4], t_base_cam[3]),
-// the map + extrinsic step's (pose as data) and the pose step's (map and extrinsic as data).
+// the map + extrinsic step's (pose as data) and the pose step's (map and extrinsic as data);
+// the step bindings with analytic Jacobians (projection_jacobians.h, PpsrWithJacobian).
 #pragma once
 
 #include <ceres/autodiff_cost_function.h>
+#include <ceres/sized_cost_function.h>
 
 #include <algorithm>
 
 #include "ipm_road_mapper/core/residuals/projection.h"
+#include "ipm_road_mapper/core/residuals/projection_jacobians.h"
 
 namespace ipm_road_mapper {
 namespace residuals {
@@ -58,8 +61,8 @@ class PpsrResidual {
 
   template <typename T>
   bool operator()(const T* const c1, const T* const c2, const T* const q_map_base,
-                  const T* const t_map_base, const T* const q_base_cam,
-                  const T* const t_base_cam, T* residual) const {
+                  const T* const t_map_base, const T* const q_base_cam, const T* const t_base_cam,
+                  T* residual) const {
     return Ppsr(camera_, uv_measured_, inv_sigma_, c1, c2, q_map_base, t_map_base, q_base_cam,
                 t_base_cam, residual);
   }
@@ -76,68 +79,138 @@ class PpsrResidual {
   double inv_sigma_;
 };
 
-// Map + extrinsic step: the frame's pose is data. Parameter blocks: c1[3], c2[3],
-// q_base_cam[4], t_base_cam[3].
-class PpsrMapStepResidual {
+// d r / d a and d r / d b of r = (I - d d^T)(a - z), d = (b - a) / |b - a|:
+//   dr = (I - d d^T) da - [(d.e) I + d e^T] dd,   dd = (I - d d^T)(db - da) / |b - a|
+// with e = a - z. False when the projected segment is degenerate.
+inline bool PpsrWithJacobian(const Eigen::Vector2d& a, const Eigen::Vector2d& b,
+                             const Eigen::Vector2d& z, Eigen::Vector2d* r, Eigen::Matrix2d* dr_da,
+                             Eigen::Matrix2d* dr_db) {
+  const Eigen::Vector2d ab = b - a;
+  const double length = ab.norm();
+  if (length < kPpsrMinSegmentPx) return false;
+  const Eigen::Vector2d d = ab / length;
+  const Eigen::Vector2d e = a - z;
+  const Eigen::Matrix2d across = Eigen::Matrix2d::Identity() - d * d.transpose();
+  *r = across * e;
+  const Eigen::Matrix2d M =
+      (d.dot(e) * Eigen::Matrix2d::Identity() + d * e.transpose()) * across / length;
+  *dr_da = across + M;
+  *dr_db = -M;
+  return true;
+}
+
+// Map + extrinsic step: the frame's pose is data; analytic Jacobians (checked against the
+// autodiffed reference). Parameter blocks: c1[3], c2[3], q_base_cam[4], t_base_cam[3].
+class PpsrMapStepResidual : public ceres::SizedCostFunction<2, 3, 3, 4, 3> {
  public:
   PpsrMapStepResidual(const PinholeCamera& camera, const Eigen::Vector2d& uv, double sigma_px,
                       const double* q_map_base, const double* t_map_base)
-      : camera_(camera), uv_measured_(uv), inv_sigma_(1.0 / sigma_px) {
-    std::copy(q_map_base, q_map_base + 4, q_map_base_);
-    std::copy(t_map_base, t_map_base + 3, t_map_base_);
-  }
+      : camera_(camera),
+        uv_measured_(uv),
+        inv_sigma_(1.0 / sigma_px),
+        R_base_map_(
+            Eigen::Map<const Eigen::Quaterniond>(q_map_base).toRotationMatrix().transpose()),
+        t_map_base_(Eigen::Map<const Eigen::Vector3d>(t_map_base)) {}
 
-  template <typename T>
-  bool operator()(const T* const c1, const T* const c2, const T* const q_base_cam,
-                  const T* const t_base_cam, T* residual) const {
-    const T q[4] = {T(q_map_base_[0]), T(q_map_base_[1]), T(q_map_base_[2]), T(q_map_base_[3])};
-    const T t[3] = {T(t_map_base_[0]), T(t_map_base_[1]), T(t_map_base_[2])};
-    return Ppsr(camera_, uv_measured_, inv_sigma_, c1, c2, q, t, q_base_cam, t_base_cam,
-                residual);
+  bool Evaluate(double const* const* parameters, double* residuals,
+                double** jacobians) const override {
+    const Eigen::Matrix3d R_cam_base =
+        Eigen::Map<const Eigen::Quaterniond>(parameters[2]).toRotationMatrix().transpose();
+    const Eigen::Map<const Eigen::Vector3d> t_base_cam(parameters[3]);
+    const Eigen::Vector3d v1 =
+        R_base_map_ * (Eigen::Map<const Eigen::Vector3d>(parameters[0]) - t_map_base_) - t_base_cam;
+    const Eigen::Vector3d v2 =
+        R_base_map_ * (Eigen::Map<const Eigen::Vector3d>(parameters[1]) - t_map_base_) - t_base_cam;
+    Eigen::Vector2d a, b, r;
+    Eigen::Matrix<double, 2, 3> J_a, J_b;
+    Eigen::Matrix2d dr_da, dr_db;
+    if (!ProjectWithJacobian(camera_, R_cam_base * v1, &a, &J_a) ||
+        !ProjectWithJacobian(camera_, R_cam_base * v2, &b, &J_b) ||
+        !PpsrWithJacobian(a, b, uv_measured_, &r, &dr_da, &dr_db)) {
+      return false;
+    }
+    StoreRowMajor(r * inv_sigma_, residuals);
+    if (!jacobians) return true;
+    const Eigen::Matrix<double, 2, 3> J1 = inv_sigma_ * dr_da * J_a;  // d r / d p_cam1
+    const Eigen::Matrix<double, 2, 3> J2 = inv_sigma_ * dr_db * J_b;  // d r / d p_cam2
+    if (jacobians[0]) StoreRowMajor(J1 * R_cam_base * R_base_map_, jacobians[0]);
+    if (jacobians[1]) StoreRowMajor(J2 * R_cam_base * R_base_map_, jacobians[1]);
+    if (jacobians[2]) {
+      StoreRowMajor(J1 * InverseRotationJacobian(parameters[2], v1) +
+                        J2 * InverseRotationJacobian(parameters[2], v2),
+                    jacobians[2]);
+    }
+    if (jacobians[3]) StoreRowMajor(-(J1 + J2) * R_cam_base, jacobians[3]);
+    return true;
   }
 
   static ceres::CostFunction* Create(const PinholeCamera& camera, const Eigen::Vector2d& uv,
                                      double sigma_px, const double* q_map_base,
                                      const double* t_map_base) {
-    return new ceres::AutoDiffCostFunction<PpsrMapStepResidual, 2, 3, 3, 4, 3>(
-        new PpsrMapStepResidual(camera, uv, sigma_px, q_map_base, t_map_base));
+    return new PpsrMapStepResidual(camera, uv, sigma_px, q_map_base, t_map_base);
   }
 
  private:
   PinholeCamera camera_;
   Eigen::Vector2d uv_measured_;
   double inv_sigma_;
-  double q_map_base_[4], t_map_base_[3];
+  Eigen::Matrix3d R_base_map_;
+  Eigen::Vector3d t_map_base_;
 };
 
-// Pose step: control points and extrinsic are data. Parameter blocks: q_map_base[4],
-// t_map_base[3].
-class PpsrPoseStepResidual {
+// Pose step: control points and extrinsic are data; analytic Jacobians. Parameter blocks:
+// q_map_base[4], t_map_base[3].
+class PpsrPoseStepResidual : public ceres::SizedCostFunction<2, 4, 3> {
  public:
   PpsrPoseStepResidual(const PinholeCamera& camera, const Eigen::Vector2d& uv, double sigma_px,
                        const Eigen::Vector3d& c1, const Eigen::Vector3d& c2,
                        const double* q_base_cam, const double* t_base_cam)
-      : camera_(camera), uv_measured_(uv), inv_sigma_(1.0 / sigma_px), c1_(c1), c2_(c2) {
-    std::copy(q_base_cam, q_base_cam + 4, q_base_cam_);
-    std::copy(t_base_cam, t_base_cam + 3, t_base_cam_);
-  }
+      : camera_(camera),
+        uv_measured_(uv),
+        inv_sigma_(1.0 / sigma_px),
+        c1_(c1),
+        c2_(c2),
+        R_cam_base_(
+            Eigen::Map<const Eigen::Quaterniond>(q_base_cam).toRotationMatrix().transpose()),
+        t_base_cam_(Eigen::Map<const Eigen::Vector3d>(t_base_cam)) {}
 
-  template <typename T>
-  bool operator()(const T* const q_map_base, const T* const t_map_base, T* residual) const {
-    const T c1[3] = {T(c1_(0)), T(c1_(1)), T(c1_(2))};
-    const T c2[3] = {T(c2_(0)), T(c2_(1)), T(c2_(2))};
-    const T q[4] = {T(q_base_cam_[0]), T(q_base_cam_[1]), T(q_base_cam_[2]), T(q_base_cam_[3])};
-    const T t[3] = {T(t_base_cam_[0]), T(t_base_cam_[1]), T(t_base_cam_[2])};
-    return Ppsr(camera_, uv_measured_, inv_sigma_, c1, c2, q_map_base, t_map_base, q, t,
-                residual);
+  bool Evaluate(double const* const* parameters, double* residuals,
+                double** jacobians) const override {
+    const Eigen::Matrix3d R_map_base =
+        Eigen::Map<const Eigen::Quaterniond>(parameters[0]).toRotationMatrix();
+    const Eigen::Map<const Eigen::Vector3d> t_map_base(parameters[1]);
+    const Eigen::Vector3d w1 = c1_ - t_map_base, w2 = c2_ - t_map_base;
+    Eigen::Vector2d a, b, r;
+    Eigen::Matrix<double, 2, 3> J_a, J_b;
+    Eigen::Matrix2d dr_da, dr_db;
+    if (!ProjectWithJacobian(camera_, R_cam_base_ * (R_map_base.transpose() * w1 - t_base_cam_), &a,
+                             &J_a) ||
+        !ProjectWithJacobian(camera_, R_cam_base_ * (R_map_base.transpose() * w2 - t_base_cam_), &b,
+                             &J_b) ||
+        !PpsrWithJacobian(a, b, uv_measured_, &r, &dr_da, &dr_db)) {
+      return false;
+    }
+    StoreRowMajor(r * inv_sigma_, residuals);
+    if (!jacobians) return true;
+    const Eigen::Matrix<double, 2, 3> J1 =
+        inv_sigma_ * dr_da * J_a * R_cam_base_;  // d r / d p_base1
+    const Eigen::Matrix<double, 2, 3> J2 = inv_sigma_ * dr_db * J_b * R_cam_base_;
+    if (jacobians[0]) {
+      StoreRowMajor(J1 * InverseRotationJacobian(parameters[0], w1) +
+                        J2 * InverseRotationJacobian(parameters[0], w2),
+                    jacobians[0]);
+    }
+    if (jacobians[1]) {
+      StoreRowMajor(-(J1 + J2) * R_map_base.transpose(), jacobians[1]);
+    }
+    return true;
   }
 
   static ceres::CostFunction* Create(const PinholeCamera& camera, const Eigen::Vector2d& uv,
                                      double sigma_px, const Eigen::Vector3d& c1,
                                      const Eigen::Vector3d& c2, const double* q_base_cam,
                                      const double* t_base_cam) {
-    return new ceres::AutoDiffCostFunction<PpsrPoseStepResidual, 2, 4, 3>(
-        new PpsrPoseStepResidual(camera, uv, sigma_px, c1, c2, q_base_cam, t_base_cam));
+    return new PpsrPoseStepResidual(camera, uv, sigma_px, c1, c2, q_base_cam, t_base_cam);
   }
 
  private:
@@ -145,7 +218,8 @@ class PpsrPoseStepResidual {
   Eigen::Vector2d uv_measured_;
   double inv_sigma_;
   Eigen::Vector3d c1_, c2_;
-  double q_base_cam_[4], t_base_cam_[3];
+  Eigen::Matrix3d R_cam_base_;
+  Eigen::Vector3d t_base_cam_;
 };
 
 }  // namespace residuals

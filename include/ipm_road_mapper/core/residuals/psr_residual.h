@@ -22,10 +22,9 @@ class PsrResidual {
   bool operator()(const T* const c0, const T* const c1, const T* const c2, const T* const c3,
                   T* residual) const {
     using V = Eigen::Matrix<T, 3, 1>;
-    const V s = CatmullRomSpline::EvaluateSegment<T>(V(c0[0], c0[1], c0[2]),
-                                                     V(c1[0], c1[1], c1[2]),
-                                                     V(c2[0], c2[1], c2[2]),
-                                                     V(c3[0], c3[1], c3[2]), T(u_));
+    const V s =
+        CatmullRomSpline::EvaluateSegment<T>(V(c0[0], c0[1], c0[2]), V(c1[0], c1[1], c1[2]),
+                                             V(c2[0], c2[1], c2[2]), V(c3[0], c3[1], c3[2]), T(u_));
     for (int i = 0; i < 3; ++i) residual[i] = (s(i) - T(q_map_(i))) * T(inv_sigma_);
     return true;
   }
