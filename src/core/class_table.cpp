@@ -35,8 +35,8 @@ ClassTable ClassTable::Load(OptionsReader reader) {
     entry.ReadRequired<std::string>("kind", &kind);
     entry.Read<std::string>("style", &style);
     entry.RejectUnknownKeys();
-    const std::string where = entry.path() + " (id " + std::to_string(info.id) + ", " +
-                              info.name + ")";
+    const std::string where =
+        entry.path() + " (id " + std::to_string(info.id) + ", " + info.name + ")";
     if (kind == "lane") {
       info.kind = ElementKind::kLane;
     } else if (kind == "marking") {

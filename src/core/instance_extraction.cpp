@@ -219,8 +219,8 @@ FrameObservations ExtractObservations(const cv::Mat& mask, const ClassTable& cla
       marking.class_id = ClassIdOf(stats.value);
       marking.instance_value = stats.value;
       marking.pixel_count = stats.pixel_count;
-      outcome = extraction::ExtractMarking(runs, stats.run_count, ipm, error_model, options,
-                                             &marking);
+      outcome =
+          extraction::ExtractMarking(runs, stats.run_count, ipm, error_model, options, &marking);
       if (outcome == GeometryOutcome::kOk) observations.markings.push_back(marking);
     }
     if (outcome == GeometryOutcome::kRange) ++counters.dropped_range;

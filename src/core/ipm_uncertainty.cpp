@@ -57,10 +57,10 @@ std::optional<IpmUncertainty> ComputeIpmUncertainty(const PinholeCamera& camera,
     result.J_h(r) = p(r).v(3);
   }
   const Eigen::Vector3d pixel_term = result.J_uv * model.pixel_error_px;
-  result.omega = pixel_term * pixel_term.transpose() +
-                 model.pitch_sigma_rad * model.pitch_sigma_rad * result.J_theta *
-                     result.J_theta.transpose() +
-                 model.height_sigma_m * model.height_sigma_m * result.J_h * result.J_h.transpose();
+  result.omega =
+      pixel_term * pixel_term.transpose() +
+      model.pitch_sigma_rad * model.pitch_sigma_rad * result.J_theta * result.J_theta.transpose() +
+      model.height_sigma_m * model.height_sigma_m * result.J_h * result.J_h.transpose();
   result.score = result.omega.trace();
   return result;
 }

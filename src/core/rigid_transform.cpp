@@ -141,9 +141,8 @@ PoseLookupStatus PoseBuffer::Lookup(double stamp, Eigen::Isometry3d* T_map_base)
     *T_map_base = poses_.back().T_map_base;
     return PoseLookupStatus::kOk;
   }
-  const auto after = std::upper_bound(
-      poses_.begin(), poses_.end(), stamp,
-      [](double s, const StampedPose& p) { return s < p.stamp; });
+  const auto after = std::upper_bound(poses_.begin(), poses_.end(), stamp,
+                                      [](double s, const StampedPose& p) { return s < p.stamp; });
   const auto before = after - 1;
   const double dt = after->stamp - before->stamp;
   if (dt > max_gap_s_) return PoseLookupStatus::kGapTooLarge;

@@ -104,9 +104,9 @@ class CatmullRomSpline {
   struct SegmentSamples {
     std::vector<Eigen::Vector3d> points;  // at u = k / (points.size() - 1)
     double step_u = 0.0;
-    double step_m = 0.0;                  // longest chord between consecutive samples
+    double step_m = 0.0;  // longest chord between consecutive samples
     Eigen::Vector3d center = Eigen::Vector3d::Zero();
-    double radius = 0.0;                  // every curve point is within this of center
+    double radius = 0.0;  // every curve point is within this of center
   };
 
   // Arc length within `segment` from u = 0 to u.

@@ -15,14 +15,14 @@ namespace ipm_road_mapper {
 
 // Tuning of the extraction (config section `extraction`).
 struct ExtractionOptions {
-  int min_marking_pixels = 150;       // smaller marking instances are dropped (tiny)
-  int min_lane_pixels = 80;           // smaller lane instances are dropped (tiny)
-  int border_margin_px = 2;           // markings with a pixel this close to the border: truncated
-  int lane_row_step = 4;              // take a lane centerline point every this many rows
-  int min_lane_points = 4;            // fewer valid centerline points: degenerate
-  int max_instances_per_frame = 300;  // beyond this, the remaining instances are dropped
-  double max_marking_range_m = 25.0;  // marking whose ground center is farther: dropped
-  double min_rectangle_side_m = 0.05; // thinner ground rectangles are degenerate
+  int min_marking_pixels = 150;        // smaller marking instances are dropped (tiny)
+  int min_lane_pixels = 80;            // smaller lane instances are dropped (tiny)
+  int border_margin_px = 2;            // markings with a pixel this close to the border: truncated
+  int lane_row_step = 4;               // take a lane centerline point every this many rows
+  int min_lane_points = 4;             // fewer valid centerline points: degenerate
+  int max_instances_per_frame = 300;   // beyond this, the remaining instances are dropped
+  double max_marking_range_m = 25.0;   // marking whose ground center is farther: dropped
+  double min_rectangle_side_m = 0.05;  // thinner ground rectangles are degenerate
 };
 
 // Reads the `extraction` section; throws OptionsError naming the bad key.
@@ -39,7 +39,6 @@ std::string ValidateMask(const cv::Mat& mask, int expected_width, int expected_h
 // frame to frame. False when a corner does not project.
 bool SetMarkingRectangle(const Ipm& ipm, const IpmErrorModel& error_model,
                          const Eigen::Vector2d& axis_base, MarkingObservation* marking);
-
 
 // Extracts every instance of `mask` (which must pass ValidateMask; an unusable mask gives
 // nothing). One scan groups the pixels by value; unknown classes, tiny instances and markings

@@ -21,7 +21,7 @@ namespace ipm_road_mapper {
 
 // Error model of one IPM measurement (DESIGN.md defaults: 2 px, 0.3 deg, 0.05 m).
 struct IpmErrorModel {
-  Eigen::Vector2d pixel_error_px{2.0, 2.0};  // e_p, the segmentation error vector (u, v)
+  Eigen::Vector2d pixel_error_px{2.0, 2.0};     // e_p, the segmentation error vector (u, v)
   double pitch_sigma_rad = 0.3 * M_PI / 180.0;  // sigma_theta: camera pitch vs the road
   double height_sigma_m = 0.05;                 // sigma_h: camera height above the road
 };

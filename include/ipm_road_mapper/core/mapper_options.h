@@ -25,14 +25,14 @@ struct IpmOptions {
 
 // How lane lines become splines (config section `lanes`).
 struct LaneOptions {
-  bool point_selection = true;        // PS: keep only the lowest-uncertainty points per frame
-  int selected_points_per_frame = 12; // N of PS, per lane observation
-  double max_selected_score_m2 = 1.0; // PS also drops points with tr(Omega_p) above this
-  SplineFitOptions fit;               // g: chord spacing etc. (starts a lane)
-  LaneEndFitOptions end_fit;          // growth of a lane's ends (chord spacing = g's)
-  int end_fit_frames = 20;            // the growth sees the selected points of this many frames
-  int merge_every_n_frames = 20;      // how often lanes that turned out to be one are merged
-  double min_new_lane_length_m = 3.0; // an unmatched observation shorter than this: no lane
+  bool point_selection = true;         // PS: keep only the lowest-uncertainty points per frame
+  int selected_points_per_frame = 12;  // N of PS, per lane observation
+  double max_selected_score_m2 = 1.0;  // PS also drops points with tr(Omega_p) above this
+  SplineFitOptions fit;                // g: chord spacing etc. (starts a lane)
+  LaneEndFitOptions end_fit;           // growth of a lane's ends (chord spacing = g's)
+  int end_fit_frames = 20;             // the growth sees the selected points of this many frames
+  int merge_every_n_frames = 20;       // how often lanes that turned out to be one are merged
+  double min_new_lane_length_m = 3.0;  // an unmatched observation shorter than this: no lane
 };
 
 // Odometry buffering at the mask stamp (config section `odometry`).

@@ -54,7 +54,7 @@ struct VectorMap {
   std::vector<MapLane> lanes;
   Eigen::Isometry3d T_base_cam = Eigen::Isometry3d::Identity();          // refined
   Eigen::Isometry3d T_base_cam_initial = Eigen::Isometry3d::Identity();  // as handed in
-  std::vector<StampedPose> trajectory;  // corrected T_map_base per processed frame
+  std::vector<StampedPose> trajectory;                 // corrected T_map_base per processed frame
   nlohmann::json metadata = nlohmann::json::object();  // method, config, counters, origin
 };
 

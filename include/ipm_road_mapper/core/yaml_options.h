@@ -46,8 +46,7 @@ class OptionsReader {
   // Reads `key` into *value when present (otherwise *value keeps its default). `check`
   // returns an empty string when the value is valid, else the reason.
   template <typename T>
-  void Read(const std::string& key, T* value,
-            const OptionCheck<T>& check = nullptr) {
+  void Read(const std::string& key, T* value, const OptionCheck<T>& check = nullptr) {
     used_.push_back(key);
     if (!node_[key]) return;
     try {
@@ -63,8 +62,7 @@ class OptionsReader {
 
   // Like Read, but the key must be present.
   template <typename T>
-  void ReadRequired(const std::string& key, T* value,
-                    const OptionCheck<T>& check = nullptr) {
+  void ReadRequired(const std::string& key, T* value, const OptionCheck<T>& check = nullptr) {
     if (!Has(key)) throw OptionsError(KeyPath(key) + ": required key is missing");
     Read<T>(key, value, check);
   }
