@@ -82,8 +82,14 @@ BackendOptions LoadBackendOptions(OptionsReader reader) {
                    [](const int& v) { return v >= 2 ? "" : "must be >= 2"; });
   reader.Read<double>("road_height_sigma_m", &o.road_height_sigma_m, CheckPositive);
   reader.Read<double>("road_height_sigma_per_m", &o.road_height_sigma_per_m, CheckNonNegative);
+  reader.Read<double>("road_plane_radius_m", &o.road_plane_radius_m, CheckNonNegative);
   reader.Read<double>("lane_anchor_along_sigma_m", &o.lane_anchor_along_sigma_m, CheckPositive);
   reader.Read<double>("lane_anchor_across_sigma_m", &o.lane_anchor_across_sigma_m, CheckPositive);
+  reader.Read<double>("lane_smoothness_sigma_m", &o.lane_smoothness_sigma_m, CheckNonNegative);
+  reader.Read<bool>("final_global_solve", &o.final_global_solve);
+  reader.Read<double>("map_step_pose_sigma_scale", &o.map_step_pose_sigma_scale, CheckNonNegative);
+  reader.Read<int>("final_global_max_frames", &o.final_global_max_frames, CheckPositiveInt);
+  reader.Read<int>("final_global_rounds", &o.final_global_rounds, CheckPositiveInt);
   reader.RejectUnknownKeys();
   return o;
 }

@@ -7,7 +7,7 @@
 #include <memory>
 
 #include "ipm_road_mapper/core/residuals/corner_reprojection_residual.h"
-#include "ipm_road_mapper/core/residuals/ground_height_prior_residual.h"
+#include "ipm_road_mapper/core/residuals/road_surface_prior_residual.h"
 
 namespace ipm_road_mapper {
 namespace {
@@ -42,7 +42,7 @@ struct Pose {
 struct CornerInChart {
   PinholeCamera camera;
   Eigen::Vector2d uv;
-  double inv_sigma;
+  Eigen::Matrix2d sqrt_information;
   Pose pose;
   Eigen::Quaterniond q0;
   Eigen::Vector3d t0;
@@ -52,7 +52,14 @@ struct CornerInChart {
     ExtrinsicAtDelta(q0, t0, delta, q, t);
     const T q_mb[4] = {T(pose.q[0]), T(pose.q[1]), T(pose.q[2]), T(pose.q[3])};
     const T t_mb[3] = {T(pose.t[0]), T(pose.t[1]), T(pose.t[2])};
-    return residuals::CornerReprojection(camera, uv, inv_sigma, point, q_mb, t_mb, q, t, residual);
+    T error[2];
+    if (!residuals::CornerReprojection(camera, uv, 1.0, point, q_mb, t_mb, q, t, error)) {
+      return false;
+    }
+    for (int i = 0; i < 2; ++i) {
+      residual[i] = T(sqrt_information(i, 0)) * error[0] + T(sqrt_information(i, 1)) * error[1];
+    }
+    return true;
   }
 };
 
@@ -121,14 +128,17 @@ ExtrinsicFactor MarginalizeIntoExtrinsic(const PinholeCamera& camera, const Extr
   const double* delta = factor.delta_lin.data();
   const double inv_sigma = 1.0 / pixel_sigma_px;
   for (const MarginalizationInput::Corner& c : input.corners) {
+    const Eigen::Matrix2d W = c.sqrt_information.isZero()
+                                  ? Eigen::Matrix2d(Eigen::Matrix2d::Identity() * inv_sigma)
+                                  : c.sqrt_information;
     ceres::AutoDiffCostFunction<CornerInChart, 2, 3, 6> cost(
-        new CornerInChart{camera, c.uv, inv_sigma, Pose(c.T_map_base), chart.q0(), chart.t0()});
+        new CornerInChart{camera, c.uv, W, Pose(c.T_map_base), chart.q0(), chart.t0()});
     normal.Add(cost, {3 * c.point, delta_offset}, {input.points[c.point].data(), delta},
                huber_scale);
   }
   for (const MarginalizationInput::RoadPrior& prior : input.road_priors) {
     std::unique_ptr<ceres::CostFunction> cost(
-        residuals::GroundHeightPriorResidual::Create(prior.T_map_road, prior.sigma_m));
+        residuals::RoadSurfacePriorResidual::Create(prior.plane, prior.sigma_m));
     normal.Add(*cost, {3 * prior.point}, {input.points[prior.point].data()}, 0.0);
   }
   normal.MarginalizePoints(&factor.H, &factor.g);

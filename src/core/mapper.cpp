@@ -92,6 +92,7 @@ FrameStatus Mapper::ProcessFrame(const FrameInput& input, std::string* reason) {
 
   OrientMarkingsAlongRoad(ipm, frame, &observations.markings);
   AddMarkings(observations, frame);
+  MergeMarkings();
   AddLanes(observations, frame);
   DropSpurious(frame.index);
   ++counters_.frames_used;
@@ -129,11 +130,8 @@ void Mapper::Finish() {
   backend_->Submit(BuildSnapshot());
   backend_->WaitIdle();
   ApplyBackendResults();
-  RefineRetiredMarkings();
+  FinalGlobalSolve();
 }
-
-
-
 
 VectorMap Mapper::ExportMap() const {
   VectorMap out;

@@ -1,7 +1,5 @@
 // The Mapper's side of the back end: building a window snapshot, retiring the elements
 // that leave the window into the extrinsic prior, and merging results into the map.
-#include <ceres/ceres.h>
-
 #include <algorithm>
 #include <cmath>
 #include <limits>
@@ -12,31 +10,18 @@
 #include "ipm_road_mapper/core/ipm.h"
 #include "ipm_road_mapper/core/mapper.h"
 #include "ipm_road_mapper/core/marking_measurement.h"
-#include "ipm_road_mapper/core/residuals/corner_reprojection_residual.h"
-#include "ipm_road_mapper/core/residuals/ground_height_prior_residual.h"
 
 namespace ipm_road_mapper {
-std::size_t Mapper::ClosestFrame(const Eigen::Vector3d& p_map) const {
-  double best = std::numeric_limits<double>::infinity();
-  std::size_t best_index = 0;
-  for (const FrameRecord& f : map_.frames) {
-    const double d = (f.T_map_base.translation() - p_map).head<2>().squaredNorm();
-    if (d < best) {
-      best = d;
-      best_index = f.index;
-    }
-  }
-  return best_index;
+RoadSurfaceEstimate Mapper::RoadSurfaceAt(const Eigen::Vector3d& p_map) const {
+  std::vector<Eigen::Isometry3d> poses;
+  poses.reserve(map_.frames.size());
+  for (const FrameRecord& f : map_.frames) poses.push_back(f.T_map_base);
+  return RoadSurfaceNear(poses, p_map, options_.backend.road_plane_radius_m);
 }
 
-void Mapper::AddRoadPrior(int point, const Eigen::Vector3d& p_map,
-                          MarginalizationInput* input) const {
-  const FrameRecord& road = map_.frames[ClosestFrame(p_map)];
-  const double distance = (road.T_map_base.translation() - p_map).head<2>().norm();
+double Mapper::RoadPriorSigma(const RoadSurfaceEstimate& road) const {
   const BackendOptions& o = options_.backend;
-  input->road_priors.push_back(
-      {point, road.T_map_base,
-       std::hypot(o.road_height_sigma_m, o.road_height_sigma_per_m * distance)});
+  return std::hypot(o.road_height_sigma_m, o.road_height_sigma_per_m * road.distance_m);
 }
 
 void Mapper::RetireMarking(MarkingElement* marking) {
@@ -46,8 +31,8 @@ void Mapper::RetireMarking(MarkingElement* marking) {
   MarginalizationInput input;
   input.points.assign(marking->corners_map.begin(), marking->corners_map.end());
   // Corners re-measured on the road plane where the vehicle passed the marking.
-  const FrameRecord& road = map_.frames[ClosestFrame(marking->Center())];
-  const RoadPlane plane{road.T_map_base.translation(), road.T_map_base.linear().col(2)};
+  const RoadSurfaceEstimate road = RoadSurfaceAt(marking->Center());
+  const RoadPlane& plane = road.plane;
   const Eigen::Vector3d axis = RoadDirectionAt(marking->Center());
   for (const MarkingMeasurement& m : marking->history) {
     const Eigen::Isometry3d& T_map_base = map_.frames[m.frame_index].T_map_base;
@@ -62,7 +47,10 @@ void Mapper::RetireMarking(MarkingElement* marking) {
     for (int c = 0; c < 4; ++c) input.corners.push_back({c, corners_uv[c], T_map_base});
   }
   if (options_.backend.optimize_z) {
-    for (int c = 0; c < 4; ++c) AddRoadPrior(c, marking->corners_map[c], &input);
+    for (int c = 0; c < 4; ++c) {
+      const RoadSurfaceEstimate at = RoadSurfaceAt(marking->corners_map[c]);
+      input.road_priors.push_back({c, at.plane, RoadPriorSigma(at)});
+    }
   }
   extrinsic_prior_.Add(MarginalizeIntoExtrinsic(camera, extrinsic_prior_, T_base_cam_, input,
                                                 options_.backend.pixel_sigma_px,
@@ -71,69 +59,63 @@ void Mapper::RetireMarking(MarkingElement* marking) {
 
 namespace {
 
-// Observations a marking needs (besides one solve) before it corrects poses.
+// A marking enters the back end once it has been seen from this close: seen only from
+// 15-20 m, with the odometry's 0.1 m of noise on the baseline, its triangulated depth is off
+// by meters (4.5 m observed), worse than the front end's IPM average, and the association
+// then starts a duplicate. It corrects poses after one solve and this many observations.
+constexpr double kMatureRangeM = 15.0;
 constexpr std::size_t kMinMatureObservations = 5;
+
+// Whether the marking has been seen from within kMatureRangeM of base_link.
+bool SeenUpClose(const MarkingElement& m) {
+  for (const MarkingMeasurement& meas : m.history) {
+    const Eigen::Vector3d center = 0.25 * (meas.corners_base[0] + meas.corners_base[1] +
+                                           meas.corners_base[2] + meas.corners_base[3]);
+    if (center.head<2>().norm() <= kMatureRangeM) return true;
+  }
+  return false;
+}
 
 }  // namespace
 
-void Mapper::RefineRetiredMarkings() {
-  if (!options_.backend.optimize_markings) return;
-  const PinholeCamera camera(camera_);
-  const Eigen::Quaterniond q_bc(T_base_cam_.linear());
-  double q_base_cam[4] = {q_bc.x(), q_bc.y(), q_bc.z(), q_bc.w()};
-  double t_base_cam[3] = {T_base_cam_.translation().x(), T_base_cam_.translation().y(),
-                          T_base_cam_.translation().z()};
-  for (MarkingElement& marking : map_.markings) {
-    if (!marking.retired || marking.history.size() < 2) continue;
-    std::array<Eigen::Vector3d, 4> corners = marking.corners_map;
-    ceres::Problem problem;
-    const FrameRecord& road = map_.frames[ClosestFrame(marking.Center())];
-    const RoadPlane plane{road.T_map_base.translation(), road.T_map_base.linear().col(2)};
-    const Eigen::Vector3d axis = RoadDirectionAt(marking.Center());
-    std::vector<std::array<double, 7>> poses;
-    poses.reserve(marking.history.size());
-    for (const MarkingMeasurement& m : marking.history) {
-      const Eigen::Isometry3d& T_map_base = map_.frames[m.frame_index].T_map_base;
-      std::array<Eigen::Vector2d, 4> corners_uv = m.corners_uv;
-      std::array<Eigen::Vector2d, 4> on_plane;
-      if (axis.norm() > 0.0 && !m.outline_uv.empty() &&
-          MeasureCornersOnPlane(camera, T_map_base * T_base_cam_, plane, axis, corners,
-                                m.outline_uv, &on_plane)) {
-        corners_uv = on_plane;
-      }
-      const Eigen::Quaterniond q(T_map_base.linear());
-      poses.push_back({q.x(), q.y(), q.z(), q.w(), T_map_base.translation().x(),
-                       T_map_base.translation().y(), T_map_base.translation().z()});
-      for (int c = 0; c < 4; ++c) {
-        problem.AddResidualBlock(residuals::CornerReprojectionMapStepResidual::Create(
-                                     camera, corners_uv[c], options_.backend.pixel_sigma_px,
-                                     poses.back().data(), poses.back().data() + 4),
-                                 new ceres::HuberLoss(options_.backend.robust_scale),
-                                 corners[c].data(), q_base_cam, t_base_cam);
-      }
-    }
-    problem.SetParameterBlockConstant(q_base_cam);
-    problem.SetParameterBlockConstant(t_base_cam);
-    const BackendOptions& o = options_.backend;
-    for (int c = 0; c < 4; ++c) {
-      if (!o.optimize_z) {
-        problem.SetManifold(corners[c].data(), new ceres::SubsetManifold(3, {2}));
-        continue;
-      }
-      const double distance = (road.T_map_base.translation() - corners[c]).head<2>().norm();
-      problem.AddResidualBlock(
-          residuals::GroundHeightPriorResidual::Create(
-              road.T_map_base,
-              std::hypot(o.road_height_sigma_m, o.road_height_sigma_per_m * distance)),
-          nullptr, corners[c].data());
-    }
-    ceres::Solver::Options solver;
-    solver.max_num_iterations = 10;
-    solver.logging_type = ceres::SILENT;
-    ceres::Solver::Summary summary;
-    ceres::Solve(solver, &problem, &summary);
-    if (summary.IsSolutionUsable()) marking.corners_map = corners;
+void Mapper::FinalGlobalSolve() {
+  const BackendOptions& o = options_.backend;
+  if (!o.final_global_solve || map_.frames.empty() ||
+      map_.frames.size() > static_cast<std::size_t>(o.final_global_max_frames)) {
+    return;
   }
+  // Everything at once: all frames free, every marking that reached the back end and every
+  // lane with all their observations, the extrinsic with the mounting prior alone (all the
+  // data it summarizes is in the problem itself).
+  WindowSnapshot snapshot;
+  snapshot.sequence = next_sequence_++;
+  snapshot.camera = camera_;
+  snapshot.T_base_cam = T_base_cam_;
+  snapshot.extrinsic_prior =
+      ExtrinsicPrior(T_base_cam_initial_, o.rotation_prior_sigma_rad, o.translation_prior_sigma_m);
+  for (const MarkingElement& m : map_.markings) {
+    if (!m.optimized) continue;
+    snapshot.markings.push_back({m.id, m.corners_map, m.history, RoadDirectionAt(m.Center()),
+                                 m.history.size() >= kMinMatureObservations});
+  }
+  for (const LaneElement& l : map_.lanes) {
+    snapshot.lanes.push_back({l.id, l.first_cp_index, l.control_points_map, l.history});
+  }
+  for (const FrameRecord& f : map_.frames) {
+    snapshot.frames.push_back({f.index, f.T_map_base, f.T_map_base_odom, true});
+  }
+  BackendOptions global = o;
+  global.rounds = o.final_global_rounds;
+  global.max_measurements_per_marking = std::max(o.max_measurements_per_marking, 30);
+  global.max_extrinsic_change_rad = 1e9;  // the trust bound guards windows, not this
+  global.max_extrinsic_change_m = 1e9;
+  const WindowResult result = SolveWindow(snapshot, global);
+  if (!result.usable) {
+    ++counters_.results_rejected;
+    return;
+  }
+  ApplyResult(result, /*include_retired=*/true);
+  ++counters_.results_applied;
 }
 
 WindowSnapshot Mapper::BuildSnapshot() {
@@ -143,6 +125,7 @@ WindowSnapshot Mapper::BuildSnapshot() {
   const std::size_t lane_first = first > window ? first - window : 0;
   for (MarkingElement& m : map_.markings) {
     if (!m.retired && m.last_frame < first && m.optimized) RetireMarking(&m);
+    if (!m.retired && m.last_frame < first) m.retired = true;  // never reached the back end
   }
   // Lane observations older than that leave the windows. Their information about the
   // extrinsic is not kept: marginalizing pixels of control points that later windows still
@@ -160,6 +143,7 @@ WindowSnapshot Mapper::BuildSnapshot() {
   std::set<std::size_t> context;  // frames of older measurements of the window's elements
   for (const MarkingElement& m : map_.markings) {
     if (m.last_frame < first) continue;  // outside the window: held fixed
+    if (!SeenUpClose(m)) continue;       // the front end's estimate until it is
     WindowMarking wm{m.id, m.corners_map, m.history, RoadDirectionAt(m.Center()),
                      m.optimized && m.history.size() >= kMinMatureObservations};
     for (const MarkingMeasurement& meas : m.history) {
@@ -195,12 +179,12 @@ void Mapper::ApplyBackendResults() {
       ++counters_.results_rejected;
       continue;
     }
-    ApplyResult(*result);
+    ApplyResult(*result, false);
     ++counters_.results_applied;
   }
 }
 
-void Mapper::ApplyResult(const WindowResult& result) {
+void Mapper::ApplyResult(const WindowResult& result, bool include_retired) {
   T_base_cam_ = result.T_base_cam;  // fed forward to the next frames' IPM
   for (const WindowFrame& f : result.frames) {
     if (f.in_window && f.index < map_.frames.size()) map_.frames[f.index].T_map_base = f.T_map_base;
@@ -208,7 +192,7 @@ void Mapper::ApplyResult(const WindowResult& result) {
   if (options_.backend.optimize_markings) {
     for (const WindowMarking& wm : result.markings) {
       for (MarkingElement& m : map_.markings) {
-        if (m.id != wm.id || m.retired) continue;
+        if (m.id != wm.id || (m.retired && !include_retired)) continue;
         m.corners_map = wm.corners_map;
         m.optimized = true;
       }

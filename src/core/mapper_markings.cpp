@@ -107,4 +107,53 @@ void Mapper::AddMarkings(const FrameObservations& observations, const FrameRecor
   }
 }
 
+void Mapper::MergeMarkings() {
+  // Two elements of one class at one place are one marking seen twice: typically a far
+  // observation that missed the element (its IPM was meters off) started a second one.
+  const double gate2 =
+      options_.association.marking_merge_distance_m * options_.association.marking_merge_distance_m;
+  for (std::size_t a = 0; a < map_.markings.size(); ++a) {
+    for (std::size_t b = a + 1; b < map_.markings.size();) {
+      MarkingElement& first = map_.markings[a];
+      MarkingElement& second = map_.markings[b];
+      if (first.class_id != second.class_id || first.retired || second.retired ||
+          (first.Center() - second.Center()).head<2>().squaredNorm() > gate2) {
+        ++b;
+        continue;
+      }
+      // The second's measurements in the first's corner order.
+      const int shift = BestCyclicShift(first.corners_map, second.corners_map, nullptr);
+      for (MarkingMeasurement m : second.history) {
+        MarkingMeasurement reordered = m;
+        for (int i = 0; i < 4; ++i) {
+          reordered.corners_uv[i] = m.corners_uv[(i + shift) % 4];
+          reordered.corners_base[i] = m.corners_base[(i + shift) % 4];
+        }
+        first.history.push_back(std::move(reordered));
+      }
+      std::sort(first.history.begin(), first.history.end(),
+                [](const MarkingMeasurement& x, const MarkingMeasurement& y) {
+                  return x.frame_index < y.frame_index;
+                });
+      // Two measurements of one frame (one-to-one association forbids it within an element):
+      // keep the first's.
+      first.history.erase(std::unique(first.history.begin(), first.history.end(),
+                                      [](const MarkingMeasurement& x, const MarkingMeasurement& y) {
+                                        return x.frame_index == y.frame_index;
+                                      }),
+                          first.history.end());
+      first.first_frame = std::min(first.first_frame, second.first_frame);
+      first.last_frame = std::max(first.last_frame, second.last_frame);
+      first.first_seen = std::min(first.first_seen, second.first_seen);
+      first.last_seen = std::max(first.last_seen, second.last_seen);
+      first.optimized = first.optimized || second.optimized;
+      if (second.center_cov_map.trace() < first.center_cov_map.trace()) {
+        first.center_cov_map = second.center_cov_map;
+      }
+      map_.markings.erase(map_.markings.begin() + b);
+      ++counters_.markings_merged;
+    }
+  }
+}
+
 }  // namespace ipm_road_mapper

@@ -14,11 +14,14 @@
 #include "ipm_road_mapper/core/residuals/along_lane_anchor_residual.h"
 #include "ipm_road_mapper/core/residuals/corner_reprojection_residual.h"
 #include "ipm_road_mapper/core/residuals/extrinsic_prior_residual.h"
-#include "ipm_road_mapper/core/residuals/ground_height_prior_residual.h"
+#include "ipm_road_mapper/core/residuals/lane_smoothness_residual.h"
 #include "ipm_road_mapper/core/residuals/pose_prior_residual.h"
+#include "ipm_road_mapper/core/residuals/pose_uncertainty.h"
 #include "ipm_road_mapper/core/residuals/ppsr_residual.h"
 #include "ipm_road_mapper/core/residuals/psr_residual.h"
+#include "ipm_road_mapper/core/residuals/road_surface_prior_residual.h"
 #include "ipm_road_mapper/core/rigid_transform.h"
+#include "ipm_road_mapper/core/road_surface.h"
 
 namespace ipm_road_mapper {
 namespace {
@@ -76,9 +79,11 @@ struct WindowState {
   std::vector<std::vector<Eigen::Vector3d>> control_points;
   std::vector<CornerMeasurement> corner_measurements;
   std::vector<LanePixel> lane_pixels;
+  std::vector<Eigen::Isometry3d> poses;  // the frames' poses at the start (road surface)
   explicit WindowState(const WindowSnapshot& s) : extrinsic(s.T_base_cam) {
     for (std::size_t i = 0; i < s.frames.size(); ++i) {
       frames.emplace_back(s.frames[i].T_map_base);
+      poses.push_back(s.frames[i].T_map_base);
       slot_of_frame[s.frames[i].index] = i;
     }
     for (const WindowMarking& m : s.markings) corners.push_back(m.corners_map);
@@ -100,24 +105,9 @@ bool ProjectsNearImage(const PinholeCamera& camera, const WindowState& state, st
          uv.y() < camera.intrinsics().height + m;
 }
 
-// The slot of the window frame horizontally closest to p_map.
-std::size_t ClosestSlot(const WindowState& state, const Eigen::Vector3d& p_map) {
-  double best = std::numeric_limits<double>::infinity();
-  std::size_t best_slot = 0;
-  for (std::size_t slot = 0; slot < state.frames.size(); ++slot) {
-    const double d =
-        (Eigen::Map<const Eigen::Vector3d>(state.frames[slot].t) - p_map).head<2>().squaredNorm();
-    if (d < best) {
-      best = d;
-      best_slot = slot;
-    }
-  }
-  return best_slot;
-}
-
 // Collects the corner measurements of the window's frames, each re-measured from its
-// outline on the road plane nearest to the marking: base_link's plane of the window frame
-// closest to it (see marking_measurement.h; the flat-ground corners are the fallback).
+// outline on the road plane at the marking (road_surface.h, from the window's frames; see
+// marking_measurement.h; the flat-ground corners are the fallback).
 void CollectCornerMeasurements(const WindowSnapshot& snapshot, const BackendOptions& options,
                                WindowState* state) {
   const PinholeCamera camera(snapshot.camera);
@@ -125,8 +115,8 @@ void CollectCornerMeasurements(const WindowSnapshot& snapshot, const BackendOpti
   for (std::size_t m = 0; m < snapshot.markings.size(); ++m) {
     const auto& corners = state->corners[m];
     const Eigen::Vector3d center = 0.25 * (corners[0] + corners[1] + corners[2] + corners[3]);
-    const Eigen::Isometry3d T_map_road = state->frames[ClosestSlot(*state, center)].ToIsometry();
-    const RoadPlane plane{T_map_road.translation(), T_map_road.linear().col(2)};
+    const RoadPlane plane =
+        RoadSurfaceNear(state->poses, center, options.road_plane_radius_m).plane;
     const Eigen::Vector3d& axis = snapshot.markings[m].axis_map;
     const auto& measurements = snapshot.markings[m].measurements;
     // At most max_measurements_per_marking of them, spread over the history (the first and
@@ -207,28 +197,17 @@ ceres::LossFunction* MakeLoss(const BackendOptions& options) {
   return nullptr;
 }
 
-// The road-surface prior of a map point (see ground_height_prior_residual.h): its height in
-// base_link of the window's frame horizontally closest to it, with a sigma that grows with
-// that distance (the road is known at the wheels, less so ahead of them).
+// The road-surface prior of a map point (road_surface_prior_residual.h): on the road plane
+// of the window's frames near it, with a sigma that grows with how far that plane is
+// extrapolated (the road is known where the wheels were, less so ahead of them).
 void AddRoadSurfacePrior(const BackendOptions& options, const WindowState& state, double* point,
                          ceres::Problem* problem) {
-  const Eigen::Vector3d p(point[0], point[1], point[2]);
-  double best = 1e18;
-  std::size_t best_slot = 0;
-  for (std::size_t slot = 0; slot < state.frames.size(); ++slot) {
-    const double d =
-        (Eigen::Map<const Eigen::Vector3d>(state.frames[slot].t) - p).head<2>().squaredNorm();
-    if (d < best) {
-      best = d;
-      best_slot = slot;
-    }
-  }
-  const double distance = std::sqrt(best);
+  const RoadSurfaceEstimate road = RoadSurfaceNear(
+      state.poses, Eigen::Vector3d(point[0], point[1], point[2]), options.road_plane_radius_m);
   const double sigma =
-      std::hypot(options.road_height_sigma_m, options.road_height_sigma_per_m * distance);
-  problem->AddResidualBlock(
-      residuals::GroundHeightPriorResidual::Create(state.frames[best_slot].ToIsometry(), sigma),
-      nullptr, point);
+      std::hypot(options.road_height_sigma_m, options.road_height_sigma_per_m * road.distance_m);
+  problem->AddResidualBlock(residuals::RoadSurfacePriorResidual::Create(road.plane, sigma), nullptr,
+                            point);
 }
 
 // Free 3D map point: z held by a subset manifold when optimize_z is off.
@@ -257,12 +236,23 @@ ceres::Solver::Summary MapStep(const WindowSnapshot& snapshot, const BackendOpti
   double* q_bc = state->extrinsic.q;
   double* t_bc = state->extrinsic.t;
   *blocks = 0;
+  // The poses are data here, but uncertain: their sigma joins the pixels' (pose_uncertainty.h).
+  const Eigen::Isometry3d T_base_cam = state->extrinsic.ToIsometry();
+  const Eigen::Vector3d sigma_t =
+      options.map_step_pose_sigma_scale * options.pose_prior_sigma_trans_m;
+  const Eigen::Vector3d sigma_r =
+      options.map_step_pose_sigma_scale * options.pose_prior_sigma_rot_rad;
+  auto whitening = [&](std::size_t slot, const Eigen::Vector3d& p_map) {
+    return residuals::PoseUncertaintyWhitening(camera, state->poses[slot], T_base_cam, p_map,
+                                               options.pixel_sigma_px, sigma_t, sigma_r);
+  };
   if (options.optimize_markings) {
     for (const CornerMeasurement& m : state->corner_measurements) {
       const PoseBlocks& pose = state->frames[m.slot];
+      auto& corner = state->corners[m.marking][m.corner];
       problem.AddResidualBlock(residuals::CornerReprojectionMapStepResidual::Create(
-                                   camera, m.uv, options.pixel_sigma_px, pose.q, pose.t),
-                               loss, state->corners[m.marking][m.corner].data(), q_bc, t_bc);
+                                   camera, m.uv, whitening(m.slot, corner), pose.q, pose.t),
+                               loss, corner.data(), q_bc, t_bc);
       ++*blocks;
     }
   }
@@ -270,10 +260,10 @@ ceres::Solver::Summary MapStep(const WindowSnapshot& snapshot, const BackendOpti
     auto& cps = state->control_points[px.lane];
     const PoseBlocks& pose = state->frames[px.slot];
     if (options.lane_residual == LaneResidual::kPpsr) {
-      problem.AddResidualBlock(residuals::PpsrMapStepResidual::Create(
-                                   camera, px.uv, options.pixel_sigma_px, pose.q, pose.t),
-                               loss, cps[px.segment + 1].data(), cps[px.segment + 2].data(), q_bc,
-                               t_bc);
+      problem.AddResidualBlock(
+          residuals::PpsrMapStepResidual::Create(
+              camera, px.uv, whitening(px.slot, cps[px.segment + 1]), pose.q, pose.t),
+          loss, cps[px.segment + 1].data(), cps[px.segment + 2].data(), q_bc, t_bc);
       ++*blocks;
     } else if (options.lane_residual == LaneResidual::kPsr) {
       problem.AddResidualBlock(residuals::PsrResidual::Create(px.q_map, px.u, options.psr_sigma_m),
@@ -296,9 +286,23 @@ ceres::Solver::Summary MapStep(const WindowSnapshot& snapshot, const BackendOpti
     }
   }
   for (auto& cps : state->control_points) {
+    // Smoothness over every triple that touches a free point (the others join as data).
+    std::vector<bool> free(cps.size());
+    for (std::size_t j = 0; j < cps.size(); ++j) free[j] = problem.HasParameterBlock(cps[j].data());
+    if (options.lane_smoothness_sigma_m > 0.0) {
+      for (std::size_t j = 1; j + 1 < cps.size(); ++j) {
+        if (!free[j - 1] && !free[j] && !free[j + 1]) continue;
+        problem.AddResidualBlock(
+            residuals::LaneSmoothnessResidual::Create(options.lane_smoothness_sigma_m), nullptr,
+            cps[j - 1].data(), cps[j].data(), cps[j + 1].data());
+        for (std::size_t k = j - 1; k <= j + 1; ++k) {
+          if (!free[k]) problem.SetParameterBlockConstant(cps[k].data());
+        }
+      }
+    }
     for (std::size_t j = 0; j < cps.size(); ++j) {
       auto& c = cps[j];
-      if (!problem.HasParameterBlock(c.data())) continue;
+      if (!free[j]) continue;
       const Eigen::Vector3d tangent = cps[std::min(j + 1, cps.size() - 1)] - cps[j > 0 ? j - 1 : 0];
       problem.AddResidualBlock(
           residuals::AlongLaneAnchorResidual::Create(c, tangent, options.lane_anchor_along_sigma_m,

@@ -1,7 +1,11 @@
 // Offline runner: builds the vector map from a bag file, without a roscore.
 //
 //   rosrun ipm_road_mapper map_from_bag --bag <bag> [--config <yaml>] [--classes <yaml>]
-//                                       --out <dir>
+//                                       [--async] --out <dir>
+//
+// The back end solves every window in turn (backend.synchronous forced on: offline the bag
+// is read far faster than real time, and an owned optimizer thread would drop most
+// windows); --async keeps the config's threading, as the nodelet runs it.
 //
 // Reads the mask, camera_info and odometry topics of the config's `input` section with the
 // rosbag C++ API, pairs each mask with its camera_info (sync exact: identical stamp;
@@ -55,7 +59,7 @@ namespace fs = std::filesystem;
 
 constexpr const char* kUsage =
     "usage: map_from_bag --bag <bag> [--config <mapper.yaml>] [--classes <classes.yaml>] "
-    "--out <dir>";
+    "[--async] --out <dir>";
 
 // Bad input: reported as one line, exit status 2.
 struct InputError : std::runtime_error {
@@ -64,6 +68,7 @@ struct InputError : std::runtime_error {
 
 struct Arguments {
   std::string bag, config, classes, out;
+  bool async = false;  // keep backend.synchronous as configured (live-like timing)
 };
 
 // A file of the package (e.g. "config/mapper.yaml"); see the file comment for the search.
@@ -79,6 +84,10 @@ Arguments ParseArguments(int argc, char** argv) {
   Arguments args;
   for (int i = 1; i < argc; ++i) {
     const std::string flag = argv[i];
+    if (flag == "--async") {
+      args.async = true;
+      continue;
+    }
     if (flag == "-h" || flag == "--help") {
       std::cout << kUsage << "\n";
       std::exit(0);
@@ -219,7 +228,10 @@ void WriteOutputs(const std::string& dir, const VectorMap& map,
 
 int Run(int argc, char** argv) {
   const Arguments args = ParseArguments(argc, argv);
-  const MapperConfig config = LoadConfig(args.config);
+  MapperConfig config = LoadConfig(args.config);
+  // Offline, every window is solved in turn (the bag is read far faster than real time, so
+  // an owned thread would drop most of them); --async keeps the config's threading.
+  if (!args.async) config.mapper.backend.synchronous = true;
   const MapperOptions& options = config.mapper;
   ClassTable classes;
   try {

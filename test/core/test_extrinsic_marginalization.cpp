@@ -10,7 +10,7 @@
 #include "ipm_road_mapper/core/extrinsic_prior.h"
 #include "ipm_road_mapper/core/residuals/corner_reprojection_residual.h"
 #include "ipm_road_mapper/core/residuals/extrinsic_prior_residual.h"
-#include "ipm_road_mapper/core/residuals/ground_height_prior_residual.h"
+#include "ipm_road_mapper/core/residuals/road_surface_prior_residual.h"
 #include "ipm_road_mapper/core/rigid_transform.h"
 
 namespace ipm_road_mapper {
@@ -118,7 +118,7 @@ Eigen::Isometry3d SolveJoint(const Scene& scene, const std::vector<int>& marking
   }
   for (int m : marking_ids) {
     for (int c = 0; c < 4; ++c) {
-      problem.AddResidualBlock(residuals::GroundHeightPriorResidual::Create(scene.poses[0], 0.05),
+      problem.AddResidualBlock(residuals::RoadSurfacePriorResidual::Create(RoadPlane(), 0.05),
                                nullptr, (*corners)[m][c].data());
     }
   }
@@ -173,7 +173,7 @@ TEST(MarginalizeIntoExtrinsic, HalfMarginalizedEqualsTheJointSolution) {
   for (int m = 0; m < 3; ++m) {
     for (int c = 0; c < 4; ++c) {
       input.points.push_back(corners[m][c]);
-      input.road_priors.push_back({4 * m + c, scene.poses[0], 0.05});
+      input.road_priors.push_back({4 * m + c, RoadPlane(), 0.05});
     }
   }
   for (const Scene::Obs& o : scene.observations) {

@@ -18,6 +18,7 @@
 #include "ipm_road_mapper/core/ipm.h"
 #include "ipm_road_mapper/core/pinhole_camera.h"
 #include "ipm_road_mapper/core/residuals/corner_reprojection_residual.h"
+#include "ipm_road_mapper/core/residuals/lane_smoothness_residual.h"
 #include "ipm_road_mapper/core/residuals/pose_prior_residual.h"
 #include "ipm_road_mapper/core/residuals/ppsr_residual.h"
 #include "ipm_road_mapper/core/residuals/projection.h"
@@ -232,11 +233,10 @@ TEST_F(ResidualTest, CornerReprojectionStepBindingsMatchTheReference) {
   const Eigen::Vector3d corner = GroundPoint(12.0, -1.5);
   const Eigen::Vector2d uv = Project(corner) + Eigen::Vector2d(3.0, -2.0);
   std::unique_ptr<ceres::CostFunction> full(CornerReprojectionResidual::Create(camera_, uv, 2.0));
-  const Eigen::VectorXd reference =
-      Evaluate(*full, {corner.data(), pose_.q.data(), pose_.t.data(), extrinsic_.q.data(),
-                       extrinsic_.t.data()});
-  std::unique_ptr<ceres::CostFunction> map_step(CornerReprojectionMapStepResidual::Create(
-      camera_, uv, 2.0, pose_.q.data(), pose_.t.data()));
+  const Eigen::VectorXd reference = Evaluate(*full, {corner.data(), pose_.q.data(), pose_.t.data(),
+                                                     extrinsic_.q.data(), extrinsic_.t.data()});
+  std::unique_ptr<ceres::CostFunction> map_step(
+      CornerReprojectionMapStepResidual::Create(camera_, uv, 2.0, pose_.q.data(), pose_.t.data()));
   const std::vector<const double*> map_blocks = {corner.data(), extrinsic_.q.data(),
                                                  extrinsic_.t.data()};
   EXPECT_LT((Evaluate(*map_step, map_blocks) - reference).norm(), 1e-12);
@@ -337,8 +337,8 @@ TEST_F(PpsrTest, GradientCheck) {
 TEST_F(PpsrTest, StepBindingsMatchTheReferenceAndPassGradientChecks) {
   const Eigen::Vector2d uv = a_ + 0.4 * (b_ - a_) + 3.0 * n_;
   const Eigen::VectorXd reference = Residual(uv, 1.5);
-  std::unique_ptr<ceres::CostFunction> map_step(PpsrMapStepResidual::Create(
-      camera_, uv, 1.5, pose_.q.data(), pose_.t.data()));
+  std::unique_ptr<ceres::CostFunction> map_step(
+      PpsrMapStepResidual::Create(camera_, uv, 1.5, pose_.q.data(), pose_.t.data()));
   const std::vector<const double*> map_blocks = {c1_.data(), c2_.data(), extrinsic_.q.data(),
                                                  extrinsic_.t.data()};
   EXPECT_LT((Evaluate(*map_step, map_blocks) - reference).norm(), 1e-12);
@@ -467,6 +467,18 @@ TEST_F(PsrTest, UsesTheFixedParameterNotTheClosestPoint) {
 
 // ---------------------------------------------------------------------------------------
 // Translation prior.
+
+TEST(LaneSmoothnessResidualTest, IsTheScaledSecondDifferenceAndPassesTheGradientCheck) {
+  const Eigen::Vector3d c0(0, 0, 0), c1(3, 0.1, 0.0), c2(6, 0.3, 0.05);
+  std::unique_ptr<ceres::CostFunction> cost(residuals::LaneSmoothnessResidual::Create(0.2));
+  const Eigen::VectorXd r = Evaluate(*cost, {c0.data(), c1.data(), c2.data()});
+  EXPECT_LT((r - (c0 - 2.0 * c1 + c2) / 0.2).norm(), 1e-12);
+  ExpectJacobiansMatch(*cost, {nullptr, nullptr, nullptr}, {c0.data(), c1.data(), c2.data()},
+                       kGradientPrecision);
+  // Evenly spaced points on a line cost nothing.
+  const Eigen::Vector3d d2(6, 0.2, 0.0);
+  EXPECT_LT(Evaluate(*cost, {c0.data(), c1.data(), d2.data()}).norm(), 1e-12);
+}
 
 TEST(TranslationPriorResidualTest, GradientCheck) {
   const Eigen::Vector3d t0(1.5, 0.0, 1.5), t(1.6, -0.2, 1.45);

@@ -25,6 +25,9 @@ struct AssociationOptions {
   // Isotropic floor of the gate's covariance (pose noise, shape, segmentation); crosswalk
   // stripes 1 m apart must stay apart: 3 sigma of the floor is 0.75 m.
   double marking_position_sigma_m = 0.25;
+  // Two elements of one class whose centers come closer than this are merged (crosswalk
+  // stripes are 1 m apart).
+  double marking_merge_distance_m = 0.5;
   // Lane points whose tr(Omega_p) exceeds this are not used to associate (or start) a lane:
   // far points of outer lines stray laterally by up to a meter.
   double lane_max_point_score_m2 = 1.0;

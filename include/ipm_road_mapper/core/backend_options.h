@@ -20,12 +20,12 @@ enum class LaneResidual {
 const char* ToString(LaneResidual residual);
 
 struct BackendOptions {
-  bool enabled = true;                  // false: plain IPM front end only
-  bool synchronous = false;             // solve in the caller's thread (offline determinism)
-  bool optimize_extrinsic = true;       // R_base_cam, t_base_cam free in the map step
-  bool optimize_markings = true;        // marking corners free in the map step
-  bool optimize_z = true;               // z of corners and control points free
-  bool pose_update = true;              // run the pose-update step
+  bool enabled = true;             // false: plain IPM front end only
+  bool synchronous = false;        // solve in the caller's thread (offline determinism)
+  bool optimize_extrinsic = true;  // R_base_cam, t_base_cam free in the map step
+  bool optimize_markings = true;   // marking corners free in the map step
+  bool optimize_z = true;          // z of corners and control points free
+  bool pose_update = true;         // run the pose-update step
   LaneResidual lane_residual = LaneResidual::kPpsr;
   int window_frames = 40;               // frames whose observations enter a solve
   int solve_every_n_frames = 5;         // how often the front end hands a window over
@@ -41,9 +41,9 @@ struct BackendOptions {
   // yaw): roll is unobservable on straight roads, pitch and yaw are observable.
   Eigen::Vector3d rotation_prior_sigma_rad{0.1 * M_PI / 180.0, 3.0 * M_PI / 180.0,
                                            3.0 * M_PI / 180.0};
-  Eigen::Vector3d pose_prior_sigma_trans_m{0.3, 0.3, 0.05};   // base_link x, y, z
+  Eigen::Vector3d pose_prior_sigma_trans_m{0.3, 0.3, 0.05};        // base_link x, y, z
   Eigen::Vector3d pose_prior_sigma_rot_rad{0.001, 0.001, 0.0052};  // roll, pitch, yaw
-  double max_extrinsic_change_rad = 2.0 * M_PI / 180.0;  // trust bound per solve
+  double max_extrinsic_change_rad = 2.0 * M_PI / 180.0;            // trust bound per solve
   double max_extrinsic_change_m = 0.2;
   int max_lane_points_per_observation = 6;  // PPSR/PSR pixels per lane observation
   int max_measurements_per_marking = 10;    // observations of a marking per solve (spread)
@@ -60,7 +60,20 @@ struct BackendOptions {
   // across it.
   double lane_anchor_along_sigma_m = 0.05;
   double lane_anchor_across_sigma_m = 0.5;
+  // Second differences of consecutive control points (lane_smoothness_residual.h); 0: off.
+  double lane_smoothness_sigma_m = 0.2;
+  // At the end of input, one solve over the whole drive (Mapper::Finish), when it has at
+  // most final_global_max_frames frames; final_global_rounds alternations.
+  bool final_global_solve = true;
+  // The map + extrinsic step weighs each measurement with the pixel sigma and the frame's
+  // pose uncertainty: the pose prior's sigmas times this (0: poses taken as exact).
+  double map_step_pose_sigma_scale = 0.3;
+  int final_global_max_frames = 3000;
+  int final_global_rounds = 3;
   double road_height_sigma_per_m = 0.01;
+  // The road's plane at a point averages the frames that drove within this radius of it
+  // (road_surface.h: the body's pitch oscillation averages out over a period, ~10 m).
+  double road_plane_radius_m = 6.0;
 };
 
 // Reads the `backend` section; throws OptionsError naming the bad key.

@@ -16,6 +16,7 @@
 
 #include "ipm_road_mapper/core/extrinsic_prior.h"
 #include "ipm_road_mapper/core/pinhole_camera.h"
+#include "ipm_road_mapper/core/road_surface.h"
 
 namespace ipm_road_mapper {
 
@@ -27,10 +28,12 @@ struct MarginalizationInput {
     int point = 0;
     Eigen::Vector2d uv;
     Eigen::Isometry3d T_map_base;
+    // Whitening of the pixel error (pose_uncertainty.h); zero: I / pixel_sigma_px.
+    Eigen::Matrix2d sqrt_information = Eigen::Matrix2d::Zero();
   };
-  struct RoadPrior {  // height of the point in base_link of T_map_road ~ 0
+  struct RoadPrior {  // the point lies on the road's plane (road_surface_prior_residual.h)
     int point = 0;
-    Eigen::Isometry3d T_map_road;
+    RoadPlane plane;
     double sigma_m = 0.1;
   };
   std::vector<Corner> corners;

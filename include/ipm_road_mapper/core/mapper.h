@@ -18,15 +18,16 @@
 #include "ipm_road_mapper/core/mapper_options.h"
 #include "ipm_road_mapper/core/pinhole_camera.h"
 #include "ipm_road_mapper/core/road_map.h"
+#include "ipm_road_mapper/core/road_surface.h"
 #include "ipm_road_mapper/core/vector_map.h"
 
 namespace ipm_road_mapper {
 
 // One camera frame as the core sees it (DESIGN.md §3).
 struct FrameInput {
-  double stamp = 0.0;                 // s, the mask's stamp
-  cv::Mat mask;                       // CV_16UC1 instance mask, camera-sized
-  CameraIntrinsics camera;            // from camera_info
+  double stamp = 0.0;       // s, the mask's stamp
+  cv::Mat mask;             // CV_16UC1 instance mask, camera-sized
+  CameraIntrinsics camera;  // from camera_info
   Eigen::Isometry3d T_map_base_odom = Eigen::Isometry3d::Identity();  // odometry at stamp
 };
 
@@ -44,12 +45,13 @@ struct MapperCounters {
   std::uint64_t lanes_created = 0;
   std::uint64_t spurious_dropped = 0;
   std::uint64_t lanes_merged = 0;
+  std::uint64_t markings_merged = 0;
   std::uint64_t lane_observations_unused = 0;  // unmatched and too short / unfit to start a lane
   // Unmatched but close to a lane of its class (within twice the gates): not a new line, so
   // not started (a second spline along one line would be a duplicate).
   std::uint64_t lane_observations_near_lane = 0;
-  std::uint64_t results_applied = 0;           // back-end results merged into the map
-  std::uint64_t results_rejected = 0;          // unusable (solver failure, trust bound)
+  std::uint64_t results_applied = 0;   // back-end results merged into the map
+  std::uint64_t results_rejected = 0;  // unusable (solver failure, trust bound)
   std::uint64_t SkippedTotal() const;
 };
 
@@ -103,6 +105,8 @@ class Mapper {
   // Unit tangent of the mapped lane nearest to p_map (within 8 m); zero when there is none.
   Eigen::Vector3d RoadDirectionAt(const Eigen::Vector3d& p_map) const;
   void AddMarkings(const FrameObservations& observations, const FrameRecord& frame);
+  // Merges elements of one class closer than association.marking_merge_distance_m.
+  void MergeMarkings();
   // Lanes (mapper_lanes.cpp): association, start, growth, merging.
   void AddLanes(const FrameObservations& observations, const FrameRecord& frame);
   void StartLane(int class_id, const LaneMeasurement& measurement,
@@ -121,16 +125,18 @@ class Mapper {
   // corners marginalized), and lane observations older than the lanes' context.
   WindowSnapshot BuildSnapshot();
   void RetireMarking(MarkingElement* marking);
-  // End of input: markings that retired while the extrinsic was still rough are re-fit to
-  // all their observations with the final extrinsic and poses (each alone: poses and
-  // extrinsic are data).
-  void RefineRetiredMarkings();
-  // The frame whose base_link origin is horizontally closest to p_map (the vehicle passed
-  // there: its base_link plane is the road's plane there), and that plane as a prior.
-  std::size_t ClosestFrame(const Eigen::Vector3d& p_map) const;
-  void AddRoadPrior(int point, const Eigen::Vector3d& p_map, MarginalizationInput* input) const;
+  // End of input (backend.final_global_solve): one solve over the whole drive, so that what
+  // retired while the extrinsic was still rough (markings, the poses that saw them) gets the
+  // final extrinsic, and the windows' alternation converges where it was slow.
+  void FinalGlobalSolve();
+  // The road's plane at p_map from all the frames' poses (road_surface.h), and the sigma of
+  // the road-surface prior there.
+  RoadSurfaceEstimate RoadSurfaceAt(const Eigen::Vector3d& p_map) const;
+  double RoadPriorSigma(const RoadSurfaceEstimate& road) const;
   void ApplyBackendResults();
-  void ApplyResult(const WindowResult& result);
+  // Merges a result into the map; retired markings only with include_retired (the final
+  // global solve: a window's late result must not move what its prior already holds).
+  void ApplyResult(const WindowResult& result, bool include_retired);
   void MergeLanes();
   void DropSpurious(std::size_t frame_index);
   void Skip(const std::string& reason, std::string* out);

@@ -17,14 +17,9 @@
 #include <vector>
 
 #include "ipm_road_mapper/core/pinhole_camera.h"
+#include "ipm_road_mapper/core/road_surface.h"
 
 namespace ipm_road_mapper {
-
-// A plane in the map frame: n . (p - point) = 0, n of unit length.
-struct RoadPlane {
-  Eigen::Vector3d point = Eigen::Vector3d::Zero();
-  Eigen::Vector3d normal = Eigen::Vector3d::UnitZ();
-};
 
 // The corner pixels of a marking observation (outline_uv, seen by the camera at T_map_cam)
 // on `plane`, its rectangle's sides along axis_map (the road's direction, projected into the

@@ -36,9 +36,9 @@ struct MarkingObservation {
 
 // One centerline point of a lane instance.
 struct LanePoint {
-  Eigen::Vector2d uv = Eigen::Vector2d::Zero();       // pixel (the PPSR measurement)
-  Eigen::Vector3d p_base = Eigen::Vector3d::Zero();   // its IPM ground point
-  double score = 0.0;                                 // tr(Omega_p), m^2
+  Eigen::Vector2d uv = Eigen::Vector2d::Zero();        // pixel (the PPSR measurement)
+  Eigen::Vector3d p_base = Eigen::Vector3d::Zero();    // its IPM ground point
+  double score = 0.0;                                  // tr(Omega_p), m^2
   Eigen::Matrix2d cov_base = Eigen::Matrix2d::Zero();  // x-y block of Omega_p, m^2
 };
 

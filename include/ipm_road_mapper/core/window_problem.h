@@ -41,8 +41,9 @@ struct WindowMarking {
   // The road's direction at the marking (tangent of the nearest lane; zero: unknown), along
   // which its corners are re-measured.
   Eigen::Vector3d axis_map = Eigen::Vector3d::Zero();
-  // Its estimate has been through an earlier solve: only such a marking corrects poses (a
-  // new one is where flat-ground IPM put it, meters off, and would drag them along).
+  // Its estimate is settled (through an earlier solve, seen from near): only such a marking
+  // corrects poses (a new one is where flat-ground IPM put it, meters off, and poses
+  // aligned to it would drift with it).
   bool mature = false;
 };
 
@@ -71,8 +72,8 @@ struct WindowSnapshot {
 // What the optimizer hands back (immutable once published).
 struct WindowResult {
   std::uint64_t sequence = 0;
-  bool usable = false;      // Ceres says the solution is usable and the trust bound holds
-  std::string reason;       // why not usable
+  bool usable = false;  // Ceres says the solution is usable and the trust bound holds
+  std::string reason;   // why not usable
   Eigen::Isometry3d T_base_cam = Eigen::Isometry3d::Identity();
   std::vector<WindowFrame> frames;
   std::vector<WindowMarking> markings;  // measurements left empty

@@ -67,12 +67,14 @@ class CornerReprojectionResidual {
 // q_base_cam[4], t_base_cam[3].
 class CornerReprojectionMapStepResidual : public ceres::SizedCostFunction<2, 3, 4, 3> {
  public:
+  // `sqrt_information` whitens the pixel error: I / sigma_px, or the inverse square root of
+  // a covariance that includes the frame's pose uncertainty (pose_uncertainty.h).
   CornerReprojectionMapStepResidual(const PinholeCamera& camera, const Eigen::Vector2d& uv,
-                                    double sigma_px, const double* q_map_base,
-                                    const double* t_map_base)
+                                    const Eigen::Matrix2d& sqrt_information,
+                                    const double* q_map_base, const double* t_map_base)
       : camera_(camera),
         uv_measured_(uv),
-        inv_sigma_(1.0 / sigma_px),
+        sqrt_information_(sqrt_information),
         R_base_map_(
             Eigen::Map<const Eigen::Quaterniond>(q_map_base).toRotationMatrix().transpose()),
         t_map_base_(Eigen::Map<const Eigen::Vector3d>(t_map_base)) {}
@@ -90,9 +92,9 @@ class CornerReprojectionMapStepResidual : public ceres::SizedCostFunction<2, 3, 
     if (!ProjectWithJacobian(camera_, R_cam_base * v, &uv, jacobians ? &J_uv : nullptr)) {
       return false;
     }
-    StoreRowMajor((uv - uv_measured_) * inv_sigma_, residuals);
+    StoreRowMajor(sqrt_information_ * (uv - uv_measured_), residuals);
     if (!jacobians) return true;
-    const Eigen::Matrix<double, 2, 3> J_cam = inv_sigma_ * J_uv;
+    const Eigen::Matrix<double, 2, 3> J_cam = sqrt_information_ * J_uv;
     if (jacobians[0]) StoreRowMajor(J_cam * R_cam_base * R_base_map_, jacobians[0]);
     if (jacobians[1]) {
       StoreRowMajor(J_cam * InverseRotationJacobian(parameters[1], v), jacobians[1]);
@@ -104,13 +106,20 @@ class CornerReprojectionMapStepResidual : public ceres::SizedCostFunction<2, 3, 
   static ceres::CostFunction* Create(const PinholeCamera& camera, const Eigen::Vector2d& uv,
                                      double sigma_px, const double* q_map_base,
                                      const double* t_map_base) {
-    return new CornerReprojectionMapStepResidual(camera, uv, sigma_px, q_map_base, t_map_base);
+    return new CornerReprojectionMapStepResidual(camera, uv, Eigen::Matrix2d::Identity() / sigma_px,
+                                                 q_map_base, t_map_base);
+  }
+  static ceres::CostFunction* Create(const PinholeCamera& camera, const Eigen::Vector2d& uv,
+                                     const Eigen::Matrix2d& sqrt_information,
+                                     const double* q_map_base, const double* t_map_base) {
+    return new CornerReprojectionMapStepResidual(camera, uv, sqrt_information, q_map_base,
+                                                 t_map_base);
   }
 
  private:
   PinholeCamera camera_;
   Eigen::Vector2d uv_measured_;
-  double inv_sigma_;
+  Eigen::Matrix2d sqrt_information_;
   Eigen::Matrix3d R_base_map_;
   Eigen::Vector3d t_map_base_;
 };

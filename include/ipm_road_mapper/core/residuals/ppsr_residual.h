@@ -103,11 +103,14 @@ inline bool PpsrWithJacobian(const Eigen::Vector2d& a, const Eigen::Vector2d& b,
 // autodiffed reference). Parameter blocks: c1[3], c2[3], q_base_cam[4], t_base_cam[3].
 class PpsrMapStepResidual : public ceres::SizedCostFunction<2, 3, 3, 4, 3> {
  public:
-  PpsrMapStepResidual(const PinholeCamera& camera, const Eigen::Vector2d& uv, double sigma_px,
-                      const double* q_map_base, const double* t_map_base)
+  // `sqrt_information` whitens the residual: I / sigma_px, or the inverse square root of a
+  // covariance that includes the frame's pose uncertainty (pose_uncertainty.h).
+  PpsrMapStepResidual(const PinholeCamera& camera, const Eigen::Vector2d& uv,
+                      const Eigen::Matrix2d& sqrt_information, const double* q_map_base,
+                      const double* t_map_base)
       : camera_(camera),
         uv_measured_(uv),
-        inv_sigma_(1.0 / sigma_px),
+        sqrt_information_(sqrt_information),
         R_base_map_(
             Eigen::Map<const Eigen::Quaterniond>(q_map_base).toRotationMatrix().transpose()),
         t_map_base_(Eigen::Map<const Eigen::Vector3d>(t_map_base)) {}
@@ -129,10 +132,10 @@ class PpsrMapStepResidual : public ceres::SizedCostFunction<2, 3, 3, 4, 3> {
         !PpsrWithJacobian(a, b, uv_measured_, &r, &dr_da, &dr_db)) {
       return false;
     }
-    StoreRowMajor(r * inv_sigma_, residuals);
+    StoreRowMajor(sqrt_information_ * r, residuals);
     if (!jacobians) return true;
-    const Eigen::Matrix<double, 2, 3> J1 = inv_sigma_ * dr_da * J_a;  // d r / d p_cam1
-    const Eigen::Matrix<double, 2, 3> J2 = inv_sigma_ * dr_db * J_b;  // d r / d p_cam2
+    const Eigen::Matrix<double, 2, 3> J1 = sqrt_information_ * dr_da * J_a;  // d r / d p_cam1
+    const Eigen::Matrix<double, 2, 3> J2 = sqrt_information_ * dr_db * J_b;  // d r / d p_cam2
     if (jacobians[0]) StoreRowMajor(J1 * R_cam_base * R_base_map_, jacobians[0]);
     if (jacobians[1]) StoreRowMajor(J2 * R_cam_base * R_base_map_, jacobians[1]);
     if (jacobians[2]) {
@@ -147,13 +150,19 @@ class PpsrMapStepResidual : public ceres::SizedCostFunction<2, 3, 3, 4, 3> {
   static ceres::CostFunction* Create(const PinholeCamera& camera, const Eigen::Vector2d& uv,
                                      double sigma_px, const double* q_map_base,
                                      const double* t_map_base) {
-    return new PpsrMapStepResidual(camera, uv, sigma_px, q_map_base, t_map_base);
+    return new PpsrMapStepResidual(camera, uv, Eigen::Matrix2d::Identity() / sigma_px, q_map_base,
+                                   t_map_base);
+  }
+  static ceres::CostFunction* Create(const PinholeCamera& camera, const Eigen::Vector2d& uv,
+                                     const Eigen::Matrix2d& sqrt_information,
+                                     const double* q_map_base, const double* t_map_base) {
+    return new PpsrMapStepResidual(camera, uv, sqrt_information, q_map_base, t_map_base);
   }
 
  private:
   PinholeCamera camera_;
   Eigen::Vector2d uv_measured_;
-  double inv_sigma_;
+  Eigen::Matrix2d sqrt_information_;
   Eigen::Matrix3d R_base_map_;
   Eigen::Vector3d t_map_base_;
 };

@@ -1,42 +1,43 @@
-// Weak prior that a map point lies near the ground plane of the frame that saw it closest:
-//   r = e_z^T R_base_map (p_map - t_map_base) / sigma_m                 (1 residual)
-// Why: with free 3D map points and a nearly straight drive, a rotation of the camera about
-// the direction of travel (extrinsic roll) is exactly compensated by rotating the whole map
-// about the trajectory line, so roll is unobservable from reprojection alone. Near the
-// vehicle the road is close to base_link's z = 0 plane (the IPM assumption, used here
-// locally and softly), which pins that rotation. The pose is data (map step only).
+// Prior that a map point lies on the road:
+//   r = n^T (p_map - point) / sigma_m                                  (1 residual)
+// with (point, n) the road's plane near the point, from the vehicle's poses (road_surface.h),
+// and sigma growing with how far that plane is extrapolated. Why: a lane seen by a camera
+// driving along it is only known to lie in the plane through the camera's path and the
+// line of sight, so without the road its height and lateral offset trade freely; the
+// extrinsic roll about the direction of travel is likewise unobservable from reprojection
+// alone on straight roads, and the road's height under the wheels fixes the camera's.
 // Parameter block: p_map[3].
 #pragma once
 
-#include <ceres/autodiff_cost_function.h>
+#include <ceres/sized_cost_function.h>
 
-#include <Eigen/Geometry>
+#include "ipm_road_mapper/core/road_surface.h"
 
 namespace ipm_road_mapper {
 namespace residuals {
 
-class GroundHeightPriorResidual {
+class RoadSurfacePriorResidual : public ceres::SizedCostFunction<1, 3> {
  public:
-  GroundHeightPriorResidual(const Eigen::Isometry3d& T_map_base, double sigma_m)
-      : row_(T_map_base.linear().col(2)),  // z row of R_base_map = z column of R_map_base
-        offset_(row_.dot(T_map_base.translation())),
-        inv_sigma_(1.0 / sigma_m) {}
+  RoadSurfacePriorResidual(const RoadPlane& plane, double sigma_m)
+      : normal_(plane.normal), offset_(plane.normal.dot(plane.point)), inv_sigma_(1.0 / sigma_m) {}
 
-  template <typename T>
-  bool operator()(const T* const p_map, T* residual) const {
-    const T z_base =
-        T(row_(0)) * p_map[0] + T(row_(1)) * p_map[1] + T(row_(2)) * p_map[2] - T(offset_);
-    residual[0] = z_base * T(inv_sigma_);
+  bool Evaluate(double const* const* parameters, double* residuals,
+                double** jacobians) const override {
+    const double* p = parameters[0];
+    residuals[0] =
+        (normal_.x() * p[0] + normal_.y() * p[1] + normal_.z() * p[2] - offset_) * inv_sigma_;
+    if (jacobians && jacobians[0]) {
+      for (int i = 0; i < 3; ++i) jacobians[0][i] = normal_(i) * inv_sigma_;
+    }
     return true;
   }
 
-  static ceres::CostFunction* Create(const Eigen::Isometry3d& T_map_base, double sigma_m) {
-    return new ceres::AutoDiffCostFunction<GroundHeightPriorResidual, 1, 3>(
-        new GroundHeightPriorResidual(T_map_base, sigma_m));
+  static ceres::CostFunction* Create(const RoadPlane& plane, double sigma_m) {
+    return new RoadSurfacePriorResidual(plane, sigma_m);
   }
 
  private:
-  Eigen::Vector3d row_;
+  Eigen::Vector3d normal_;
   double offset_;
   double inv_sigma_;
 };

@@ -1,0 +1,32 @@
+// The road's surface near a map point, as the vehicle's poses know it. base_link's origin is
+// on the road and its z axis is the road's normal, up to the body's pitch and roll
+// oscillation on its suspension (0.3 deg here, 1.3 cm over half a 5 m marking, which a
+// camera looking along the road turns into 13 cm along it). The frames that drove within a
+// radius of the point are averaged, which averages that oscillation out; a point no frame
+// has passed yet gets the closest frame's plane, extrapolated.
+#pragma once
+
+#include <Eigen/Geometry>
+#include <vector>
+
+namespace ipm_road_mapper {
+
+// A plane in the map frame: n . (p - point) = 0, n of unit length, pointing up.
+struct RoadPlane {
+  Eigen::Vector3d point = Eigen::Vector3d::Zero();
+  Eigen::Vector3d normal = Eigen::Vector3d::UnitZ();
+};
+
+// The plane near p_map and how far it is extrapolated.
+struct RoadSurfaceEstimate {
+  RoadPlane plane;
+  double distance_m = 0.0;  // horizontal distance from p_map to the closest frame used
+  int frames = 0;           // frames averaged (0: no pose at all)
+};
+
+// Averages the base_link planes (mean origin, mean z axis) of the poses within radius_m of
+// p_map horizontally, or takes the closest pose's when none is that close.
+RoadSurfaceEstimate RoadSurfaceNear(const std::vector<Eigen::Isometry3d>& T_map_base,
+                                    const Eigen::Vector3d& p_map, double radius_m);
+
+}  // namespace ipm_road_mapper

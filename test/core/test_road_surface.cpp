@@ -1,0 +1,93 @@
+// The road surface from the vehicle's poses: averaging the frames near a point removes the
+// body's pitch oscillation; a point no frame has passed gets the closest frame's plane and
+// its distance. And the pose-uncertainty whitening of the map step's residuals.
+#include <gtest/gtest.h>
+
+#include <cmath>
+
+#include "ipm_road_mapper/core/residuals/pose_uncertainty.h"
+#include "ipm_road_mapper/core/rigid_transform.h"
+#include "ipm_road_mapper/core/road_surface.h"
+
+namespace ipm_road_mapper {
+namespace {
+
+constexpr double kDeg = M_PI / 180.0;
+
+// A drive along x on a road with a 2 % grade, the body pitching +-0.3 deg at 1.1 Hz (10 m/s,
+// a pose every 0.5 m).
+std::vector<Eigen::Isometry3d> PitchingDrive() {
+  std::vector<Eigen::Isometry3d> poses;
+  const double grade = std::atan(0.02);
+  for (int k = 0; k < 100; ++k) {
+    const double x = 0.5 * k, t = 0.05 * k;
+    const double body = 0.3 * kDeg * std::sin(2.0 * M_PI * 1.1 * t);
+    Eigen::Isometry3d T = Eigen::Isometry3d::Identity();
+    T.linear() = RotationFromRpy(0.0, -grade + body, 0.0);  // nose up on the grade: -pitch
+    T.translation() = Eigen::Vector3d(x, 0.0, 0.02 * x);
+    poses.push_back(T);
+  }
+  return poses;
+}
+
+TEST(RoadSurfaceNear, AveragesThePitchOscillationOut) {
+  const auto poses = PitchingDrive();
+  const Eigen::Vector3d p(25.0, 1.5, 0.5);  // a marking corner beside the path
+  const RoadSurfaceEstimate road = RoadSurfaceNear(poses, p, 6.0);
+  EXPECT_GT(road.frames, 10);
+  EXPECT_NEAR(road.distance_m, 1.5, 0.01);
+  // The true road there: z = 0.02 x, normal (-0.02, 0, 1) normalized.
+  const Eigen::Vector3d normal_true = Eigen::Vector3d(-0.02, 0.0, 1.0).normalized();
+  // 1.3 periods of the oscillation in the radius: a part remains (0.06 deg here).
+  EXPECT_LT(std::acos(std::min(1.0, road.plane.normal.dot(normal_true))), 0.1 * kDeg);
+  const double height = road.plane.normal.dot(Eigen::Vector3d(25.0, 1.5, 0.5) - road.plane.point);
+  EXPECT_NEAR(height, 0.0, 0.005);
+  // One frame's plane (radius 0) carries its body pitch: up to 0.3 deg off.
+  const RoadSurfaceEstimate one = RoadSurfaceNear(poses, p, 0.0);
+  EXPECT_EQ(one.frames, 1);
+  EXPECT_GT(std::acos(std::min(1.0, one.plane.normal.dot(normal_true))), 0.1 * kDeg);
+}
+
+TEST(RoadSurfaceNear, ExtrapolatesTheClosestFrameAheadAndHandlesNoPoses) {
+  const auto poses = PitchingDrive();
+  const RoadSurfaceEstimate ahead = RoadSurfaceNear(poses, Eigen::Vector3d(70.0, 0.0, 1.4), 6.0);
+  EXPECT_EQ(ahead.frames, 1);
+  EXPECT_NEAR(ahead.distance_m, 70.0 - 49.5, 1e-9);
+  EXPECT_TRUE((ahead.plane.point - poses.back().translation()).isZero());
+  EXPECT_EQ(RoadSurfaceNear({}, Eigen::Vector3d::Zero(), 6.0).frames, 0);
+}
+
+TEST(PoseUncertaintyWhitening, IsThePixelSigmaForExactPosesAndWeakerOtherwise) {
+  CameraIntrinsics c;
+  c.width = 1280;
+  c.height = 720;
+  c.fx = c.fy = 1000.0;
+  c.cx = 639.5;
+  c.cy = 359.5;
+  const PinholeCamera camera(c);
+  Eigen::Matrix3d R_base_optical;
+  R_base_optical << 0, 0, 1, -1, 0, 0, 0, -1, 0;
+  Eigen::Isometry3d T_base_cam = Eigen::Isometry3d::Identity();
+  T_base_cam.linear() = RotationFromRpy(0.0, 4.0 * kDeg, 0.0) * R_base_optical;
+  T_base_cam.translation() = Eigen::Vector3d(1.5, 0.0, 1.5);
+  const Eigen::Isometry3d T_map_base = Eigen::Isometry3d::Identity();
+  const Eigen::Vector3d near(8.0, 1.0, 0.0), far(25.0, 1.0, 0.0);
+  const Eigen::Matrix2d exact = residuals::PoseUncertaintyWhitening(
+      camera, T_map_base, T_base_cam, near, 2.0, Eigen::Vector3d::Zero(), Eigen::Vector3d::Zero());
+  EXPECT_LT((exact - Eigen::Matrix2d::Identity() / 2.0).norm(), 1e-12);
+  // 0.1 m of longitudinal pose error moves a ground point 8 m ahead by ~2.5 px in v: its
+  // vertical information drops; 25 m ahead much less (the pixel shift falls as 1/d^2).
+  const Eigen::Vector3d sigma_t(0.1, 0.0, 0.0);
+  const Eigen::Matrix2d W_near = residuals::PoseUncertaintyWhitening(
+      camera, T_map_base, T_base_cam, near, 2.0, sigma_t, Eigen::Vector3d::Zero());
+  const Eigen::Matrix2d W_far = residuals::PoseUncertaintyWhitening(
+      camera, T_map_base, T_base_cam, far, 2.0, sigma_t, Eigen::Vector3d::Zero());
+  const double info_near = (W_near.transpose() * W_near)(1, 1);
+  const double info_far = (W_far.transpose() * W_far)(1, 1);
+  EXPECT_LT(info_near, 0.5 * 0.25);  // at least halved from 1 / 2^2
+  EXPECT_GT(info_far, info_near);
+  EXPECT_LE(info_far, 0.25 + 1e-12);
+}
+
+}  // namespace
+}  // namespace ipm_road_mapper
