@@ -86,6 +86,11 @@ BackendOptions LoadBackendOptions(OptionsReader reader) {
   reader.Read<double>("lane_anchor_along_sigma_m", &o.lane_anchor_along_sigma_m, CheckPositive);
   reader.Read<double>("lane_anchor_across_sigma_m", &o.lane_anchor_across_sigma_m, CheckPositive);
   reader.Read<double>("lane_smoothness_sigma_m", &o.lane_smoothness_sigma_m, CheckNonNegative);
+  reader.Read<bool>("motion_prior", &o.motion_prior);
+  o.motion_sigma_acc_mps2 =
+      ReadTriple(&reader, "motion_sigma_acc_mps2", o.motion_sigma_acc_mps2, 1.0);
+  o.motion_sigma_angular_acc_radps2 = ReadTriple(&reader, "motion_sigma_angular_acc_radps2",
+                                                 o.motion_sigma_angular_acc_radps2, 1.0);
   reader.Read<bool>("final_global_solve", &o.final_global_solve);
   reader.Read<double>("map_step_pose_sigma_scale", &o.map_step_pose_sigma_scale, CheckNonNegative);
   reader.Read<int>("final_global_max_frames", &o.final_global_max_frames, CheckPositiveInt);

@@ -102,7 +102,7 @@ void Mapper::FinalGlobalSolve() {
     snapshot.lanes.push_back({l.id, l.first_cp_index, l.control_points_map, l.history});
   }
   for (const FrameRecord& f : map_.frames) {
-    snapshot.frames.push_back({f.index, f.T_map_base, f.T_map_base_odom, true});
+    snapshot.frames.push_back({f.index, f.T_map_base, f.T_map_base_odom, true, f.stamp});
   }
   BackendOptions global = o;
   global.rounds = o.final_global_rounds;
@@ -163,11 +163,11 @@ WindowSnapshot Mapper::BuildSnapshot() {
   }
   for (std::size_t i : context) {
     const FrameRecord& f = map_.frames[i];
-    snapshot.frames.push_back({f.index, f.T_map_base, f.T_map_base_odom, false});
+    snapshot.frames.push_back({f.index, f.T_map_base, f.T_map_base_odom, false, f.stamp});
   }
   for (std::size_t i = first; i < map_.frames.size(); ++i) {
     const FrameRecord& f = map_.frames[i];
-    snapshot.frames.push_back({f.index, f.T_map_base, f.T_map_base_odom, true});
+    snapshot.frames.push_back({f.index, f.T_map_base, f.T_map_base_odom, true, f.stamp});
   }
   return snapshot;
 }

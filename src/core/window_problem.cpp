@@ -15,6 +15,7 @@
 #include "ipm_road_mapper/core/residuals/corner_reprojection_residual.h"
 #include "ipm_road_mapper/core/residuals/extrinsic_prior_residual.h"
 #include "ipm_road_mapper/core/residuals/lane_smoothness_residual.h"
+#include "ipm_road_mapper/core/residuals/motion_prior_residual.h"
 #include "ipm_road_mapper/core/residuals/pose_prior_residual.h"
 #include "ipm_road_mapper/core/residuals/pose_uncertainty.h"
 #include "ipm_road_mapper/core/residuals/ppsr_residual.h"
@@ -360,6 +361,24 @@ ceres::Solver::Summary PoseStep(const WindowSnapshot& snapshot, const BackendOpt
   if (*blocks == 0) {
     delete loss;
     return ceres::Solver::Summary();
+  }
+  // The motion prior over consecutive frames (by index) that touch a free pose; the others
+  // of a triple join as data.
+  if (options.motion_prior) {
+    for (std::size_t i = 1; i + 1 < state->frames.size(); ++i) {
+      const WindowFrame& a = snapshot.frames[i - 1];
+      const WindowFrame& b = snapshot.frames[i];
+      const WindowFrame& c = snapshot.frames[i + 1];
+      if (b.index != a.index + 1 || c.index != b.index + 1) continue;
+      if (!problem.HasParameterBlock(state->frames[i].q)) continue;  // no data on the middle one
+      const double dt_a = b.stamp - a.stamp, dt_b = c.stamp - b.stamp;
+      if (!(dt_a > 0.0) || !(dt_b > 0.0)) continue;
+      PoseBlocks &pa = state->frames[i - 1], &pb = state->frames[i], &pc = state->frames[i + 1];
+      problem.AddResidualBlock(
+          residuals::MotionPriorResidual::Create(dt_a, dt_b, options.motion_sigma_acc_mps2,
+                                                 options.motion_sigma_angular_acc_radps2),
+          nullptr, pa.q, pa.t, pb.q, pb.t, pc.q, pc.t);
+    }
   }
   for (std::size_t i = 0; i < state->frames.size(); ++i) {
     PoseBlocks& pose = state->frames[i];

@@ -19,6 +19,7 @@
 #include "ipm_road_mapper/core/pinhole_camera.h"
 #include "ipm_road_mapper/core/residuals/corner_reprojection_residual.h"
 #include "ipm_road_mapper/core/residuals/lane_smoothness_residual.h"
+#include "ipm_road_mapper/core/residuals/motion_prior_residual.h"
 #include "ipm_road_mapper/core/residuals/pose_prior_residual.h"
 #include "ipm_road_mapper/core/residuals/ppsr_residual.h"
 #include "ipm_road_mapper/core/residuals/projection.h"
@@ -591,6 +592,91 @@ TEST_F(PosePriorTest, IsInvariantToQuaternionSign) {
     EXPECT_GT(r.tail<3>().norm(), 1.0);
     EXPECT_NEAR((r - r_neg).norm(), 0.0, 1e-9);
   }
+}
+
+// ---------------------------------------------------------------------------------------
+// Motion prior.
+
+class MotionPriorTest : public ::testing::Test {
+ protected:
+  Eigen::VectorXd Residual(const std::array<PoseBlocks, 3>& p) const {
+    std::unique_ptr<ceres::CostFunction> cost(
+        MotionPriorResidual::Create(dt_a_, dt_b_, sigma_acc_, sigma_ang_));
+    return Evaluate(*cost, {p[0].q.data(), p[0].t.data(), p[1].q.data(), p[1].t.data(),
+                            p[2].q.data(), p[2].t.data()});
+  }
+  // Unequal steps and anisotropic sigmas, so that a swapped dt or axis fails.
+  const double dt_a_ = 0.05, dt_b_ = 0.06;
+  const Eigen::Vector3d sigma_acc_ = Eigen::Vector3d(1.0, 2.0, 4.0);
+  const Eigen::Vector3d sigma_ang_ = Eigen::Vector3d(0.5, 0.25, 0.125);
+};
+
+TEST_F(MotionPriorTest, IsZeroForConstantVelocityAndConstantTurnRate) {
+  // Straight map-frame velocity while the body yaws at a constant rate (the two parts are
+  // independent in the finite differences, so this is the exact zero of the residual).
+  const Eigen::Vector3d v(8.0, 3.0, 0.2);
+  const double yaw_rate = 0.3, pitch = 2.0 * kDeg;
+  std::array<PoseBlocks, 3> p;
+  const double t[3] = {0.0, dt_a_, dt_a_ + dt_b_};
+  for (int i = 0; i < 3; ++i) {
+    Eigen::Isometry3d T = Eigen::Isometry3d::Identity();
+    T.linear() = RotationFromRpy(0.0, pitch, 0.4 + yaw_rate * t[i]);
+    T.translation() = Eigen::Vector3d(5.0, -2.0, 0.3) + v * t[i];
+    p[i] = ToBlocks(T);
+  }
+  EXPECT_LT(Residual(p).norm(), 1e-9);
+  p[1] = Negated(p[1]);  // the quaternion sign means nothing
+  EXPECT_LT(Residual(p).norm(), 1e-9);
+}
+
+TEST_F(MotionPriorTest, IsTheAccelerationInTheMiddleBaseFrameOverSigma) {
+  // The middle pose yawed 90 deg: map x is base -y. Acceleration a along map x.
+  const double dt = 0.5 * (dt_a_ + dt_b_);
+  const Eigen::Vector3d a_map(1.5, 0.0, 0.0);
+  const Eigen::Vector3d v0(10.0, 0.0, 0.0);
+  const Eigen::Vector3d t0(0, 0, 0), t1 = t0 + v0 * dt_a_, t2 = t1 + (v0 + a_map * dt) * dt_b_;
+  std::array<PoseBlocks, 3> p;
+  const Eigen::Vector3d ts[3] = {t0, t1, t2};
+  for (int i = 0; i < 3; ++i) {
+    Eigen::Isometry3d T = Eigen::Isometry3d::Identity();
+    T.linear() = RotationFromRpy(0.0, 0.0, M_PI / 2);
+    T.translation() = ts[i];
+    p[i] = ToBlocks(T);
+  }
+  const Eigen::VectorXd r = Residual(p);
+  EXPECT_NEAR(r(0), 0.0, 1e-9);
+  EXPECT_NEAR(r(1), -1.5 / sigma_acc_(1), 1e-9);
+  EXPECT_NEAR(r(2), 0.0, 1e-9);
+  EXPECT_LT(r.tail<3>().norm(), 1e-9);
+}
+
+TEST_F(MotionPriorTest, IsTheChangeOfTurnRateOverSigma) {
+  // Yaw rate 0.1 rad/s, then 0.2 rad/s, translation still: the base z row carries it.
+  const double dt = 0.5 * (dt_a_ + dt_b_);
+  const double yaw[3] = {0.0, 0.1 * dt_a_, 0.1 * dt_a_ + 0.2 * dt_b_};
+  std::array<PoseBlocks, 3> p;
+  for (int i = 0; i < 3; ++i) p[i] = ToBlocks(PoseFromXyYaw(1.0, 2.0, yaw[i]));
+  const Eigen::VectorXd r = Residual(p);
+  EXPECT_LT(r.head<3>().norm(), 1e-9);
+  EXPECT_NEAR(r(5), 0.1 / (dt * sigma_ang_(2)), 1e-9);
+  EXPECT_NEAR(r(3), 0.0, 1e-9);
+  EXPECT_NEAR(r(4), 0.0, 1e-9);
+}
+
+TEST_F(MotionPriorTest, GradientCheck) {
+  std::unique_ptr<ceres::CostFunction> cost(
+      MotionPriorResidual::Create(dt_a_, dt_b_, sigma_acc_, sigma_ang_));
+  const PoseBlocks p0 = ToBlocks(VehiclePose());
+  const PoseBlocks p1 = ToBlocks(
+      VehiclePose() * ExpSe3((Vector6d() << 0.5, 0.02, 0.01, 0.003, -0.002, 0.02).finished()));
+  const PoseBlocks p2 = ToBlocks(
+      VehiclePose() * ExpSe3((Vector6d() << 1.1, -0.03, 0.02, -0.004, 0.003, 0.05).finished()));
+  const std::vector<const ceres::Manifold*> manifolds = {
+      &kQuaternionManifold, nullptr, &kQuaternionManifold, nullptr, &kQuaternionManifold, nullptr};
+  ExpectJacobiansMatch(
+      *cost, manifolds,
+      {p0.q.data(), p0.t.data(), p1.q.data(), p1.t.data(), p2.q.data(), p2.t.data()},
+      kGradientPrecision);
 }
 
 // ---------------------------------------------------------------------------------------

@@ -62,6 +62,11 @@ struct BackendOptions {
   double lane_anchor_across_sigma_m = 0.5;
   // Second differences of consecutive control points (lane_smoothness_residual.h); 0: off.
   double lane_smoothness_sigma_m = 0.2;
+  // Motion prior of the pose step (motion_prior_residual.h): finite-difference accelerations
+  // of consecutive poses, per base_link axis.
+  bool motion_prior = true;
+  Eigen::Vector3d motion_sigma_acc_mps2{1.0, 1.0, 2.0};            // x y z
+  Eigen::Vector3d motion_sigma_angular_acc_radps2{0.5, 0.5, 0.2};  // roll pitch yaw
   // At the end of input, one solve over the whole drive (Mapper::Finish), when it has at
   // most final_global_max_frames frames; final_global_rounds alternations.
   bool final_global_solve = true;

@@ -31,6 +31,7 @@ struct WindowFrame {
   // In the window: its pose is free in the pose step. Otherwise a context frame (older
   // measurements of the window's elements were made from it): its pose is data.
   bool in_window = true;
+  double stamp = 0.0;  // s (the motion prior's time steps)
 };
 
 // A marking observed in the window, with its in-window measurements.
