@@ -202,9 +202,10 @@ double CatmullRomSpline::SquaredDistance(int segment, double u,
 
 CatmullRomSpline::ClosestPoint CatmullRomSpline::FindClosest(const Eigen::Vector3d& query) const {
   // 1) Coarse: per segment, the best of its precomputed samples (step <= ~0.25 m of arc).
-  //    Segments are visited by increasing lower bound |query - center| - radius of their
-  //    bounding sphere and the visit stops once that bound exceeds the best sample so far
-  //    (no point of such a segment can be closer). 2) A visited segment can only beat the
+  //    A segment whose lower bound |query - center| - radius (its bounding sphere) exceeds
+  //    the best sample so far cannot hold a closer point and is skipped; the segment of the
+  //    smallest bound goes first, so that the bound prunes nearly all others (a linear scan,
+  //    no sort: long lanes have hundreds of segments). 2) A visited segment can only beat the
   //    best coarse sample d* if its own best sample d_i satisfies d_i - step_i <= d* (any
   //    curve point lies within one step of a sample), so only those are refined. 3) Refine by
   //    golden-section search on the bracket of the two neighboring samples; the bracket ends
@@ -215,15 +216,15 @@ CatmullRomSpline::ClosestPoint CatmullRomSpline::FindClosest(const Eigen::Vector
     double u;
   };
   const int n = NumSegments();
-  std::vector<std::pair<double, int>> order(n);
+  std::vector<double> lower_bound(n);
+  int first = 0;
   for (int i = 0; i < n; ++i) {
-    order[i] = {(query - samples_[i].center).norm() - samples_[i].radius, i};
+    lower_bound[i] = (query - samples_[i].center).norm() - samples_[i].radius;
+    if (lower_bound[i] < lower_bound[first]) first = i;
   }
-  std::sort(order.begin(), order.end());
   std::vector<Coarse> coarse;
   double best_coarse = std::numeric_limits<double>::infinity();
-  for (const auto& [lower_bound, i] : order) {
-    if (lower_bound > best_coarse) break;
+  auto visit = [&](int i) {
     const SegmentSamples& samples = samples_[i];
     Coarse best{i, std::numeric_limits<double>::infinity(), 0.0};
     for (std::size_t k = 0; k < samples.points.size(); ++k) {
@@ -235,6 +236,10 @@ CatmullRomSpline::ClosestPoint CatmullRomSpline::FindClosest(const Eigen::Vector
     }
     best_coarse = std::min(best_coarse, best.distance);
     coarse.push_back(best);
+  };
+  if (n > 0) visit(first);
+  for (int i = 0; i < n; ++i) {
+    if (i != first && lower_bound[i] <= best_coarse) visit(i);
   }
   // Segment order as in a plain scan, so that ties resolve to the lower segment.
   std::sort(coarse.begin(), coarse.end(),
