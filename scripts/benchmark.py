@@ -211,11 +211,12 @@ def main():
             md = m["_metadata"]
             frames = md.get("frames_used", 0) or 0
             rows.append([s, label, fmt(frames / m["_wall_s"] if m["_wall_s"] > 0 else None, 0),
+                         fmt(md.get("frontend_time_p50_ms"), 2), fmt(md.get("frontend_time_p95_ms"), 2),
                          fmt(1e3 * md["backend_solve_time_p50_s"], 1) if "backend_solve_time_p50_s" in md else "-",
                          fmt(1e3 * md["backend_solve_time_p95_s"], 1) if "backend_solve_time_p95_s" in md else "-",
                          md.get("backend_solves", "-"), md.get("backend_results_rejected", "-")])
     table("Speed (map_from_bag wall clock incl. bag reading; one core for the solver)",
-          ["scenario", "method", "frames/s", "solve p50 (ms)", "solve p95 (ms)", "solves",
+          ["scenario", "method", "frames/s", "front end p50 (ms)", "front end p95 (ms)", "solve p50 (ms)", "solve p95 (ms)", "solves",
            "rejected"], rows)
     json.dump({"%s/%s" % k: {kk: vv for kk, vv in v.items() if not kk.startswith("_")}
                for k, v in results.items()}, open(os.path.join(out_root, "results.json"), "w"),

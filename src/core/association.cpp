@@ -14,6 +14,7 @@ AssociationOptions LoadAssociationOptions(OptionsReader reader) {
   reader.Read<double>("marking_gate_sigmas", &o.marking_gate_sigmas, CheckPositive);
   reader.Read<double>("marking_position_sigma_m", &o.marking_position_sigma_m, CheckPositive);
   reader.Read<double>("marking_merge_distance_m", &o.marking_merge_distance_m, CheckNonNegative);
+  reader.Read<double>("marking_merge_overlap", &o.marking_merge_overlap, CheckProbability);
   reader.Read<double>("lane_max_point_score_m2", &o.lane_max_point_score_m2, CheckPositive);
   reader.Read<double>("lane_gate_m", &o.lane_gate_m, CheckPositive);
   reader.Read<double>("lane_gate_sigmas", &o.lane_gate_sigmas, CheckPositive);

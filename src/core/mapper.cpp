@@ -1,6 +1,7 @@
 #include "ipm_road_mapper/core/mapper.h"
 
 #include <algorithm>
+#include <chrono>
 #include <cmath>
 #include <sstream>
 
@@ -67,6 +68,14 @@ std::string Mapper::ValidateInput(const FrameInput& input) const {
   return "";
 }
 
+double FrontEndTiming::Quantile(std::vector<float> series, double q) {
+  if (series.empty()) return 0.0;
+  const std::size_t k =
+      std::min(series.size() - 1, static_cast<std::size_t>(q * static_cast<double>(series.size())));
+  std::nth_element(series.begin(), series.begin() + static_cast<std::ptrdiff_t>(k), series.end());
+  return series[k];
+}
+
 FrameStatus Mapper::ProcessFrame(const FrameInput& input, std::string* reason) {
   ++counters_.frames_received;
   const std::string error = ValidateInput(input);
@@ -78,10 +87,17 @@ FrameStatus Mapper::ProcessFrame(const FrameInput& input, std::string* reason) {
   camera_ = input.camera;
   ApplyBackendResults();
 
+  using Clock = std::chrono::steady_clock;
+  const auto elapsed_ms = [](Clock::time_point since) {
+    return static_cast<float>(
+        std::chrono::duration<double, std::milli>(Clock::now() - since).count());
+  };
+  const Clock::time_point start = Clock::now();
   const Ipm ipm(PinholeCamera(input.camera), T_base_cam_, options_.ipm.max_range_m);
   FrameObservations observations =
       ExtractObservations(input.mask, classes_, ipm, options_.ipm.error_model, options_.extraction);
   counters_.extraction.Add(observations.counters);
+  frontend_timing_.extraction_ms.push_back(elapsed_ms(start));
 
   FrameRecord frame;
   frame.index = map_.frames.size();
@@ -95,6 +111,7 @@ FrameStatus Mapper::ProcessFrame(const FrameInput& input, std::string* reason) {
   MergeMarkings();
   AddLanes(observations, frame);
   DropSpurious(frame.index);
+  frontend_timing_.total_ms.push_back(elapsed_ms(start));
   ++counters_.frames_used;
   if (backend_ && counters_.frames_used % options_.backend.solve_every_n_frames == 0) {
     backend_->Submit(BuildSnapshot());
@@ -181,6 +198,10 @@ VectorMap Mapper::ExportMap() const {
   out.metadata["backend"] = backend_ ? ToString(options_.backend.lane_residual) : "off";
   out.metadata["backend_results_applied"] = counters_.results_applied;
   out.metadata["backend_results_rejected"] = counters_.results_rejected;
+  out.metadata["frontend_time_p50_ms"] = FrontEndTiming::Quantile(frontend_timing_.total_ms, 0.5);
+  out.metadata["frontend_time_p95_ms"] = FrontEndTiming::Quantile(frontend_timing_.total_ms, 0.95);
+  out.metadata["frontend_extraction_p50_ms"] =
+      FrontEndTiming::Quantile(frontend_timing_.extraction_ms, 0.5);
   if (backend_) {
     const BackendStats stats = backend_->stats();
     std::vector<double> times = stats.solve_times_s;

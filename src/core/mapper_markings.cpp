@@ -2,7 +2,10 @@
 // elements, and the plain-IPM estimate (the running mean of the observed corners) until the
 // back end owns a marking.
 #include <algorithm>
+#include <array>
 #include <cmath>
+#include <opencv2/imgproc.hpp>
+#include <vector>
 
 #include "ipm_road_mapper/core/association.h"
 #include "ipm_road_mapper/core/catmull_rom_spline.h"
@@ -107,20 +110,60 @@ void Mapper::AddMarkings(const FrameObservations& observations, const FrameRecor
   }
 }
 
+namespace {
+
+// Area of the intersection of two ground rectangles (x-y), over the smaller one's area.
+double OverlapOfSmaller(const std::array<Eigen::Vector3d, 4>& a,
+                        const std::array<Eigen::Vector3d, 4>& b) {
+  auto polygon = [](const std::array<Eigen::Vector3d, 4>& corners) {
+    std::vector<cv::Point2f> p;
+    for (const Eigen::Vector3d& c : corners) p.emplace_back(c.x(), c.y());
+    if (cv::contourArea(p, true) < 0.0) std::reverse(p.begin(), p.end());  // counterclockwise
+    return p;
+  };
+  const std::vector<cv::Point2f> pa = polygon(a), pb = polygon(b);
+  const double smaller = std::min(cv::contourArea(pa), cv::contourArea(pb));
+  if (!(smaller > 1e-6)) return 0.0;
+  std::vector<cv::Point2f> intersection;
+  const double area = cv::intersectConvexConvex(pa, pb, intersection, true);
+  return std::max(0.0, area) / smaller;
+}
+
+}  // namespace
+
 void Mapper::MergeMarkings() {
   // Two elements of one class at one place are one marking seen twice: typically a far
-  // observation that missed the element (its IPM was meters off) started a second one.
-  const double gate2 =
-      options_.association.marking_merge_distance_m * options_.association.marking_merge_distance_m;
+  // observation that missed the element (its IPM was meters off) started a second one, or a
+  // close-range view (partly outside the image's useful part) did.
+  const AssociationOptions& o = options_.association;
+  const double gate2 = o.marking_merge_distance_m * o.marking_merge_distance_m;
+  auto same_marking = [&](const MarkingElement& x, const MarkingElement& y) {
+    const Eigen::Vector2d d = (x.Center() - y.Center()).head<2>();
+    if (d.squaredNorm() <= gate2) return true;
+    if (o.marking_merge_overlap <= 0.0) return false;
+    // Cheap reject: rectangles that cannot touch.
+    auto radius = [](const MarkingElement& e) {
+      double r = 0.0;
+      for (const Eigen::Vector3d& c : e.corners_map)
+        r = std::max(r, (c - e.Center()).head<2>().norm());
+      return r;
+    };
+    if (d.norm() > radius(x) + radius(y)) return false;
+    return OverlapOfSmaller(x.corners_map, y.corners_map) >= o.marking_merge_overlap;
+  };
   for (std::size_t a = 0; a < map_.markings.size(); ++a) {
     for (std::size_t b = a + 1; b < map_.markings.size();) {
-      MarkingElement& first = map_.markings[a];
-      MarkingElement& second = map_.markings[b];
-      if (first.class_id != second.class_id || first.retired || second.retired ||
-          (first.Center() - second.Center()).head<2>().squaredNorm() > gate2) {
+      if (map_.markings[a].class_id != map_.markings[b].class_id || map_.markings[a].retired ||
+          map_.markings[b].retired || !same_marking(map_.markings[a], map_.markings[b])) {
         ++b;
         continue;
       }
+      // The better-observed element stays (its id and its corners).
+      if (map_.markings[b].history.size() > map_.markings[a].history.size()) {
+        std::swap(map_.markings[a], map_.markings[b]);
+      }
+      MarkingElement& first = map_.markings[a];
+      MarkingElement& second = map_.markings[b];
       // The second's measurements in the first's corner order.
       const int shift = BestCyclicShift(first.corners_map, second.corners_map, nullptr);
       for (MarkingMeasurement m : second.history) {

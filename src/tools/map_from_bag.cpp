@@ -167,6 +167,19 @@ std::string BackendLine(const Mapper& mapper) {
   return s.str();
 }
 
+// One line about the front end's time per frame (the caller's thread).
+std::string FrontEndLine(const Mapper& mapper) {
+  const FrontEndTiming& t = mapper.frontend_timing();
+  std::ostringstream s;
+  s.setf(std::ios::fixed);
+  s.precision(2);
+  s << "front end: " << FrontEndTiming::Quantile(t.total_ms, 0.5) << " ms/frame median, "
+    << FrontEndTiming::Quantile(t.total_ms, 0.95) << " ms p95, "
+    << FrontEndTiming::Quantile(t.total_ms, 1.0) << " ms max (extraction "
+    << FrontEndTiming::Quantile(t.extraction_ms, 0.5) << " ms median)";
+  return s.str();
+}
+
 std::string Summary(const Arguments& args, const Mapper& mapper, const FrameAssembler& assembler,
                     const VectorMap& map, const RunStats& stats) {
   const MapperCounters& c = mapper.counters();
@@ -192,6 +205,7 @@ std::string Summary(const Arguments& args, const Mapper& mapper, const FrameAsse
     << c.spurious_dropped << ", lanes merged " << c.lanes_merged << ", lane observations unused "
     << c.lane_observations_unused << ", near a lane " << c.lane_observations_near_lane << ")\n"
     << BackendLine(mapper) << "\n"
+    << FrontEndLine(mapper) << "\n"
     << "wall time: " << stats.wall_s << " s; "
     << (stats.wall_s > 0 ? stats.frames_read / stats.wall_s : 0.0) << " frames/s; bag span "
     << stats.bag_span_s << " s; real-time factor "

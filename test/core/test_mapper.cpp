@@ -1,13 +1,12 @@
 // The core Mapper end to end on rendered masks: elements are created once and re-observed,
 // lanes grow, spurious elements are dropped, and every kind of bad input is skipped with a
 // counted reason without touching the map.
-#include "ipm_road_mapper/core/mapper.h"
-
 #include <gtest/gtest.h>
 
 #include <opencv2/imgproc.hpp>
 
 #include "ipm_road_mapper/core/ipm.h"
+#include "ipm_road_mapper/core/mapper.h"
 
 namespace ipm_road_mapper {
 namespace {
@@ -37,12 +36,13 @@ ClassTable TestClasses() {
 classes:
   - {id: 2, name: lane_white_dashed, kind: lane, style: dashed}
   - {id: 10, name: arrow_straight, kind: marking}
-)"), ""));
+)"),
+                                        ""));
 }
 
 // Fills the ground polygon (map frame, z = 0) seen from T_map_base into the mask.
-void FillGround(const std::vector<Eigen::Vector3d>& polygon_map, const Eigen::Isometry3d& T_map_base,
-                int value, cv::Mat* mask) {
+void FillGround(const std::vector<Eigen::Vector3d>& polygon_map,
+                const Eigen::Isometry3d& T_map_base, int value, cv::Mat* mask) {
   const Ipm ipm(PinholeCamera(TestCamera()), TestExtrinsic(), 100.0);
   std::vector<cv::Point> pixels;
   for (std::size_t i = 0; i < polygon_map.size(); ++i) {
@@ -51,7 +51,8 @@ void FillGround(const std::vector<Eigen::Vector3d>& polygon_map, const Eigen::Is
       Eigen::Vector2d uv;
       const Eigen::Vector3d p_base = T_map_base.inverse() * (a + (b - a) * (k / 20.0));
       if (!ipm.BaseToPixel(p_base, &uv)) return;
-      pixels.emplace_back(static_cast<int>(std::lround(uv.x())), static_cast<int>(std::lround(uv.y())));
+      pixels.emplace_back(static_cast<int>(std::lround(uv.x())),
+                          static_cast<int>(std::lround(uv.y())));
     }
   }
   cv::fillPoly(*mask, std::vector<std::vector<cv::Point>>{pixels}, cv::Scalar(value));
@@ -113,6 +114,36 @@ TEST(Mapper, ReobservedMarkingIsOneElementAtTheRightPlace) {
   }
 }
 
+// A long stripe seen from shifted odometry lands 1.2 m along the road from its element:
+// beyond a tight association gate and beyond the merge distance, but the two ground
+// rectangles overlap by 70%, so they are one marking (and two with the overlap test off).
+std::size_t StripeElements(double merge_overlap) {
+  MapperOptions options;
+  options.backend.enabled = false;
+  options.association.marking_gate_sigmas = 0.2;
+  options.association.marking_merge_overlap = merge_overlap;
+  Mapper mapper(options, TestClasses(), TestExtrinsic());
+  for (int k = 0; k < 8; ++k) {
+    const double x_vehicle = 0.5 * k;
+    FrameInput in;
+    in.stamp = 100.0 + 0.05 * k;
+    in.camera = TestCamera();
+    in.mask = cv::Mat::zeros(720, 1280, CV_16UC1);
+    FillGround(Rect(20.0, 24.0, -0.25, 0.25), PoseAt(x_vehicle), 10001, &in.mask);
+    in.T_map_base_odom = PoseAt(x_vehicle + (k >= 5 ? 1.2 : 0.0));
+    EXPECT_EQ(mapper.ProcessFrame(in), FrameStatus::kUsed);
+  }
+  std::size_t total_observations = 0;
+  for (const MarkingElement& m : mapper.map().markings) total_observations += m.history.size();
+  EXPECT_EQ(total_observations, 8u);  // nothing lost either way
+  return mapper.map().markings.size();
+}
+
+TEST(Mapper, OverlappingElementsOfOneClassAreMerged) {
+  EXPECT_EQ(StripeElements(0.0), 2u);
+  EXPECT_EQ(StripeElements(0.5), 1u);
+}
+
 // The lane must be one spline that grows as the vehicle drives. With point selection only
 // the near, low-uncertainty points feed g, so the spline reaches about as far as the last
 // frame's near range; without it, as far as the camera sees (35 m ahead).
@@ -138,9 +169,7 @@ void ExpectDashedLaneGrows(bool point_selection, double min_x_max) {
 
 TEST(Mapper, DashedLaneIsOneGrowingSpline) { ExpectDashedLaneGrows(false, 80.0); }
 
-TEST(Mapper, DashedLaneIsOneGrowingSplineWithPointSelection) {
-  ExpectDashedLaneGrows(true, 62.0);
-}
+TEST(Mapper, DashedLaneIsOneGrowingSplineWithPointSelection) { ExpectDashedLaneGrows(true, 62.0); }
 
 TEST(Mapper, MarkingSeenOnceIsDroppedAsSpurious) {
   Mapper mapper = MakeMapper();

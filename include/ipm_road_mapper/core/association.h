@@ -28,6 +28,10 @@ struct AssociationOptions {
   // Two elements of one class whose centers come closer than this are merged (crosswalk
   // stripes are 1 m apart).
   double marking_merge_distance_m = 0.5;
+  // ... or whose ground rectangles overlap by at least this fraction of the smaller one's
+  // area (a marking seen as two, e.g. a close-range view that missed its element; real
+  // markings do not overlap). 0 = off.
+  double marking_merge_overlap = 0.5;
   // Lane points whose tr(Omega_p) exceeds this are not used to associate (or start) a lane:
   // far points of outer lines stray laterally by up to a meter.
   double lane_max_point_score_m2 = 1.0;

@@ -9,6 +9,7 @@
 #include <memory>
 #include <opencv2/core.hpp>
 #include <string>
+#include <vector>
 
 #include "ipm_road_mapper/core/backend.h"
 #include "ipm_road_mapper/core/class_table.h"
@@ -55,6 +56,15 @@ struct MapperCounters {
   std::uint64_t SkippedTotal() const;
 };
 
+// Wall time of the front end per used frame (mask -> observations -> map update; the
+// back end's snapshot and merges excluded), for the summaries and the benchmark.
+struct FrontEndTiming {
+  std::vector<float> extraction_ms;  // mask -> instances -> IPM measurements
+  std::vector<float> total_ms;       // extraction + orientation, association, map update
+  // The q-quantile (0..1) of a series; 0 when empty.
+  static double Quantile(std::vector<float> series, double q);
+};
+
 // The mapper: the front end runs in the caller's thread; with options.backend.enabled it
 // hands sliding windows to the back end (an owned optimizer thread, or inline when
 // backend.synchronous) and merges its results at the start of the next frame.
@@ -90,6 +100,7 @@ class Mapper {
 
   const RoadMap& map() const { return map_; }
   const MapperCounters& counters() const { return counters_; }
+  const FrontEndTiming& frontend_timing() const { return frontend_timing_; }
   const MapperOptions& options() const { return options_; }
   const ClassTable& classes() const { return classes_; }
   const Eigen::Isometry3d& T_base_cam() const { return T_base_cam_; }
@@ -147,6 +158,7 @@ class Mapper {
   Eigen::Isometry3d T_base_cam_;
   RoadMap map_;
   MapperCounters counters_;
+  FrontEndTiming frontend_timing_;
   double last_stamp_ = -1.0;
   CameraIntrinsics camera_;  // of the last used frame
   std::uint64_t next_sequence_ = 1;
