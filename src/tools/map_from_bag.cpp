@@ -8,16 +8,15 @@
 // windows); --async keeps the config's threading, as the nodelet runs it.
 //
 // Reads the mask, camera_info and odometry topics of the config's `input` section with the
-// rosbag C++ API, pairs each mask with its camera_info (sync exact: identical stamp;
-// approximate: nearest within half a frame period) and with odometry interpolated at its
-// stamp (FrameAssembler, the same code the nodelet uses), runs the core Mapper, and writes
-// <dir>/map.json, <dir>/map.geojson, <dir>/trajectory_tum.txt and <dir>/summary.txt.
-// The rough extrinsic T_base_cam is the config's input.extrinsic when given, else the bag's
-// /tf_static transform from input.base_frame to the mask's header.frame_id (a chain of
-// static transforms is composed).
-// Defaults: --config and --classes are config/mapper.yaml and config/classes.yaml of the
-// package, found by rospack (ROS_PACKAGE_PATH), else under $IRM_SOURCE_DIR, else in the
-// install space next to the executable (../../share/ipm_road_mapper).
+// rosbag C++ API (masks and odometry read ahead in a thread: BagPrefetcher), pairs each mask with
+// its camera_info (sync exact: identical stamp; approximate: nearest within half a frame period)
+// and with odometry interpolated at its stamp (FrameAssembler, the same code the nodelet uses),
+// runs the core Mapper, and writes <dir>/map.json, <dir>/map.geojson, <dir>/trajectory_tum.txt and
+// <dir>/summary.txt. The rough extrinsic T_base_cam is the config's input.extrinsic when given,
+// else the bag's /tf_static transform from input.base_frame to the mask's header.frame_id (a chain
+// of static transforms is composed). Defaults: --config and --classes are config/mapper.yaml and
+// config/classes.yaml of the package, found by rospack (ROS_PACKAGE_PATH), else under
+// $IRM_SOURCE_DIR, else in the install space next to the executable (../../share/ipm_road_mapper).
 // Exit status: 0 done; 2 bad input (missing bag, bad config, missing topic, no extrinsic, ...)
 // with one error line on stderr; 1 an output could not be written.
 #include <nav_msgs/Odometry.h>
@@ -45,6 +44,7 @@
 #include "ipm_road_mapper/core/rigid_transform.h"
 #include "ipm_road_mapper/core/vector_map.h"
 #include "ipm_road_mapper/ros/bag_input.h"
+#include "ipm_road_mapper/ros/bag_prefetcher.h"
 #include "ipm_road_mapper/ros/extrinsic_source.h"
 #include "ipm_road_mapper/ros/map_files.h"
 #include "ipm_road_mapper/ros/mapper_config.h"
@@ -279,37 +279,40 @@ int Run(int argc, char** argv) {
   // The same pipeline as the nodelet's; no odometry wait rule offline (the bag is complete).
   MappingSession session(options, classes);
   session.Start(T_base_cam);
-  rosbag::View view(bag, rosbag::TopicQuery({input.mask_topic, input.odom_topic}));
+  rosbag::View span_view(bag, rosbag::TopicQuery({input.mask_topic, input.odom_topic}));
   const std::size_t total_masks = rosbag::View(bag, rosbag::TopicQuery(input.mask_topic)).size();
   std::cerr << "map_from_bag: " << total_masks << " masks, " << camera_infos.size()
             << " camera_infos; extrinsic from " << stats.extrinsic_source << "\n";
 
   ProgressMeter progress(total_masks, "frames");
   const auto start = std::chrono::steady_clock::now();
-  for (const rosbag::MessageInstance& message : view) {
-    if (message.getTopic() == input.odom_topic) {
-      const auto odometry = message.instantiate<nav_msgs::Odometry>();
-      StampedPose pose;
-      // An unconvertible message (e.g. a zero quaternion) is handed on as a NaN pose, so the
-      // assembler counts it as bad_odometry like any other invalid pose.
-      if (!odometry || !OdometryToStampedPose(*odometry, &pose).empty()) {
-        pose.T_map_base.matrix().setConstant(std::numeric_limits<double>::quiet_NaN());
-      }
-      session.AddOdometry(pose, nullptr);
-    } else {
-      const auto mask = message.instantiate<sensor_msgs::Image>();
-      if (mask) {
-        AddMask(*mask, camera_infos, exact_sync, &session);
+  {
+    // The bag is read and deserialized ahead, in its own thread; mapping stays in this one.
+    BagPrefetcher prefetcher(bag, input.mask_topic, input.odom_topic);
+    BagPrefetcher::Item message;
+    while (prefetcher.Next(&message)) {
+      if (!message.is_mask) {
+        StampedPose pose;
+        // An unconvertible message (e.g. a zero quaternion) is handed on as a NaN pose, so
+        // the assembler counts it as bad_odometry like any other invalid pose.
+        if (!message.odometry || !OdometryToStampedPose(*message.odometry, &pose).empty()) {
+          pose.T_map_base.matrix().setConstant(std::numeric_limits<double>::quiet_NaN());
+        }
+        session.AddOdometry(pose, nullptr);
       } else {
-        session.CountSkipped("bad_mask_message: not a sensor_msgs/Image", nullptr);
+        if (message.mask) {
+          AddMask(*message.mask, camera_infos, exact_sync, &session);
+        } else {
+          session.CountSkipped("bad_mask_message: not a sensor_msgs/Image", nullptr);
+        }
+        progress.Update(++stats.frames_read);
       }
-      progress.Update(++stats.frames_read);
     }
   }
   session.Finish(nullptr);  // waiting frames decided, the last window's solve merged
   progress.Finish();
   stats.wall_s = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
-  stats.bag_span_s = (view.getEndTime() - view.getBeginTime()).toSec();
+  stats.bag_span_s = (span_view.getEndTime() - span_view.getBeginTime()).toSec();
 
   const Mapper& mapper = *session.mapper();
   VectorMap map = mapper.ExportMap();
