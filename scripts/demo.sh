@@ -63,10 +63,17 @@ if [ "${IRM_DEMO_LIVE:-0}" = 1 ]; then
   ROS_MASTER_URI="http://localhost:$port" roslaunch -p "$port" ipm_road_mapper demo.launch \
     bag:="$drive/drive.bag" save_map_path:="$out/live/map.json" >"$out/live.log" 2>&1 &
   launch_pid=$!
-  # Wait for the player to finish (it leaves the graph), then stop: the nodelet saves its map.
-  sleep 5
-  for _ in $(seq 1 600); do
-    ROS_MASTER_URI="http://localhost:$port" rosnode list 2>/dev/null | grep -q '^/player$' || break
+  # Wait for the player to finish (seen in the graph, then gone), then stop: the nodelet
+  # saves its map. A failed `rosnode list` (master still starting, busy) proves nothing.
+  seen=0
+  for i in $(seq 1 600); do
+    if nodes=$(ROS_MASTER_URI="http://localhost:$port" rosnode list 2>/dev/null); then
+      if grep -q '^/player$' <<<"$nodes"; then
+        seen=1
+      elif [ "$seen" = 1 ] || [ "$i" -gt 60 ]; then
+        break
+      fi
+    fi
     sleep 1
   done
   kill -INT "$launch_pid"

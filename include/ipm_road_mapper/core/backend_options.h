@@ -55,6 +55,10 @@ struct BackendOptions {
   // through the camera path (height against lateral offset), and the extrinsic roll about
   // the direction of travel is unobservable.
   double road_height_sigma_m = 0.02;
+  double road_height_sigma_per_m = 0.01;
+  // The road's plane at a point averages the frames that drove within this radius of it
+  // (road_surface.h: the body's pitch oscillation averages out over a period, ~10 m).
+  double road_plane_radius_m = 6.0;
   // Anchor of each free lane control point to its value at the start of a solve
   // (along_lane_anchor_residual.h): tight along the lane (PPSR leaves that free), loose
   // across it.
@@ -62,6 +66,9 @@ struct BackendOptions {
   double lane_anchor_across_sigma_m = 0.5;
   // Second differences of consecutive control points (lane_smoothness_residual.h); 0: off.
   double lane_smoothness_sigma_m = 0.2;
+  // The map + extrinsic step weighs each measurement with the pixel sigma and the frame's
+  // pose uncertainty: the pose prior's sigmas times this (0: poses taken as exact).
+  double map_step_pose_sigma_scale = 0.3;
   // Motion prior of the pose step (motion_prior_residual.h): finite-difference accelerations
   // of consecutive poses, per base_link axis.
   bool motion_prior = true;
@@ -70,15 +77,8 @@ struct BackendOptions {
   // At the end of input, one solve over the whole drive (Mapper::Finish), when it has at
   // most final_global_max_frames frames; final_global_rounds alternations.
   bool final_global_solve = true;
-  // The map + extrinsic step weighs each measurement with the pixel sigma and the frame's
-  // pose uncertainty: the pose prior's sigmas times this (0: poses taken as exact).
-  double map_step_pose_sigma_scale = 0.3;
   int final_global_max_frames = 3000;
   int final_global_rounds = 3;
-  double road_height_sigma_per_m = 0.01;
-  // The road's plane at a point averages the frames that drove within this radius of it
-  // (road_surface.h: the body's pitch oscillation averages out over a period, ~10 m).
-  double road_plane_radius_m = 6.0;
 };
 
 // Reads the `backend` section; throws OptionsError naming the bad key.
