@@ -106,7 +106,16 @@ double LaneAssociationCost(const LaneElement& lane, const LaneCandidate& candida
   }
   if (points.size() < 2) return -1.0;
   const double floor = options.lane_position_sigma_m * options.lane_position_sigma_m;
-  const CatmullRomSpline spline(lane.control_points_map);
+  // Only the part of the lane near the observation (a lane can be kilometers long); the
+  // margin covers points past an end that still count.
+  std::size_t first = 0, last = 0;
+  if (!ControlPointRangeNear(lane.control_points_map, points, options.lane_max_end_gap_m + 5.0,
+                             &first, &last)) {
+    return -1.0;
+  }
+  const CatmullRomSpline spline(std::vector<Eigen::Vector3d>(
+      lane.control_points_map.begin() + first, lane.control_points_map.begin() + last + 1));
+  const bool has_start = first == 0, has_end = last + 1 == lane.control_points_map.size();
   // Observation direction: from its first to its last point (ordered along the lane).
   Eigen::Vector2d obs_dir = (points.back() - points.front()).head<2>();
   if (obs_dir.norm() < 1e-6) return -1.0;
@@ -126,7 +135,7 @@ double LaneAssociationCost(const LaneElement& lane, const LaneCandidate& candida
     tangent.normalize();
     const Eigen::Vector2d offset = (p - closest.point).head<2>();
     const double along = offset.dot(tangent);
-    const bool at_end = closest.s <= 1e-6 || closest.s >= end_s - 1e-6;
+    const bool at_end = (has_start && closest.s <= 1e-6) || (has_end && closest.s >= end_s - 1e-6);
     if (at_end && std::abs(along) > options.lane_max_end_gap_m) continue;
     // Past an end, the lateral distance is measured to the end tangent line.
     const double lateral_m =

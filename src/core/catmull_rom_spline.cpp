@@ -274,4 +274,39 @@ CatmullRomSpline::ClosestPoint CatmullRomSpline::FindClosest(const Eigen::Vector
   return result;
 }
 
+bool ControlPointRangeNear(const std::vector<Eigen::Vector3d>& control_points,
+                           const std::vector<Eigen::Vector3d>& points, double margin_m,
+                           std::size_t* first, std::size_t* last) {
+  if (control_points.size() < 4 || points.empty()) return false;
+  Eigen::Vector2d lo = points.front().head<2>(), hi = lo;
+  for (const Eigen::Vector3d& p : points) {
+    lo = lo.cwiseMin(p.head<2>());
+    hi = hi.cwiseMax(p.head<2>());
+  }
+  lo.array() -= margin_m;
+  hi.array() += margin_m;
+  std::size_t a = control_points.size(), b = 0;
+  for (std::size_t j = 0; j < control_points.size(); ++j) {
+    const Eigen::Vector2d c = control_points[j].head<2>();
+    if ((c.array() >= lo.array()).all() && (c.array() <= hi.array()).all()) {
+      a = std::min(a, j);
+      b = std::max(b, j);
+    }
+  }
+  if (a == control_points.size()) return false;
+  *first = a > 0 ? a - 1 : 0;
+  *last = std::min(control_points.size() - 1, b + 1);
+  // A curve of at least 4 points: widen at whichever end can.
+  while (*last - *first + 1 < 4) {
+    if (*first > 0) {
+      --*first;
+    } else if (*last + 1 < control_points.size()) {
+      ++*last;
+    } else {
+      return false;
+    }
+  }
+  return true;
+}
+
 }  // namespace ipm_road_mapper

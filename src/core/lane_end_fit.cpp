@@ -89,7 +89,19 @@ std::vector<Eigen::Vector3d> FitLaneEnds(const std::vector<Eigen::Vector3d>& con
 
   // 2. Curve parameters of the points; the segments they fall on decide the free points.
   const int n = static_cast<int>(cps.size());
-  const CatmullRomSpline spline(cps);
+  // Closest points on the part of the curve near the points only (a lane can be kilometers
+  // long; the points are its recent observations): segment k there is segment offset + k.
+  std::vector<Eigen::Vector3d> all_points = finite;
+  if (extension_points) all_points.insert(all_points.end(), growth.begin(), growth.end());
+  std::size_t first = 0, last = cps.size() - 1;
+  if (!ControlPointRangeNear(cps, all_points, options.max_point_distance_m + 5.0, &first, &last)) {
+    first = 0;
+    last = cps.size() - 1;
+  }
+  const int offset = static_cast<int>(first);
+  const bool has_start = first == 0, has_end = last + 1 == cps.size();
+  const CatmullRomSpline spline(
+      std::vector<Eigen::Vector3d>(cps.begin() + first, cps.begin() + last + 1));
   struct Sample {
     int segment;
     Eigen::Vector4d basis;
@@ -103,10 +115,12 @@ std::vector<Eigen::Vector3d> FitLaneEnds(const std::vector<Eigen::Vector3d>& con
     for (const Eigen::Vector3d& p : set) {
       const CatmullRomSpline::ClosestPoint closest = spline.FindClosest(p);
       if (closest.distance_m > options.max_point_distance_m) continue;
-      const bool at_end = closest.s <= 0.0 || closest.s >= spline.NumSegments();
+      const bool at_end =
+          (has_start && closest.s <= 0.0) || (has_end && closest.s >= spline.NumSegments());
       if (at_end && closest.distance_m > kEndSnapM) continue;
-      samples.push_back({closest.segment, Basis(closest.u), p, set_weight, set_weight});
-      for (int j = 0; j < 4; ++j) free[closest.segment + j] = true;
+      const int segment = offset + closest.segment;
+      samples.push_back({segment, Basis(closest.u), p, set_weight, set_weight});
+      for (int j = 0; j < 4; ++j) free[segment + j] = true;
     }
   };
   add_samples(finite, 1.0);

@@ -26,8 +26,13 @@ Eigen::Vector3d Mapper::RoadDirectionAt(const Eigen::Vector3d& p_map) const {
   double best = kRoadAxisMaxDistanceM;
   Eigen::Vector3d tangent_map = Eigen::Vector3d::Zero();
   for (const LaneElement& lane : map_.lanes) {
-    if (lane.control_points_map.size() < 4) continue;
-    const CatmullRomSpline spline(lane.control_points_map);
+    std::size_t first = 0, last = 0;  // the lane's part near p_map only
+    if (!ControlPointRangeNear(lane.control_points_map, {p_map}, kRoadAxisMaxDistanceM + 5.0,
+                               &first, &last)) {
+      continue;
+    }
+    const CatmullRomSpline spline(std::vector<Eigen::Vector3d>(
+        lane.control_points_map.begin() + first, lane.control_points_map.begin() + last + 1));
     const CatmullRomSpline::ClosestPoint closest = spline.FindClosest(p_map);
     if (closest.distance_m >= best) continue;
     best = closest.distance_m;

@@ -199,5 +199,35 @@ TEST(CatmullRomSpline, ConstructorRejectsTooFewOrNonFinitePoints) {
   EXPECT_THROW(spline.Evaluate(std::numeric_limits<double>::quiet_NaN()), std::invalid_argument);
 }
 
+// The sub-curve of ControlPointRangeNear is the whole curve near the region: same closest
+// points for queries there, segment indices offset by `first`; nothing for a far region.
+TEST(ControlPointRangeNear, SubCurveMatchesTheWholeCurveNearTheRegion) {
+  std::vector<Eigen::Vector3d> cps;
+  for (int i = 0; i < 200; ++i) {  // 600 m, gently curving
+    const double x = 3.0 * i;
+    cps.emplace_back(x, 0.002 * x * x / 10.0, 0.01 * std::sin(0.1 * x));
+  }
+  const CatmullRomSpline whole(cps);
+  const std::vector<Eigen::Vector3d> region = {{300.0, 17.0, 0.0}, {330.0, 23.0, 0.0}};
+  std::size_t first = 0, last = 0;
+  ASSERT_TRUE(ControlPointRangeNear(cps, region, 10.0, &first, &last));
+  EXPECT_LT(last - first, 25u);  // ~50 m of a 600 m lane
+  EXPECT_GT(first, 0u);
+  EXPECT_LT(last, cps.size() - 1);
+  const CatmullRomSpline sub(
+      std::vector<Eigen::Vector3d>(cps.begin() + first, cps.begin() + last + 1));
+  for (double x = 295.0; x <= 335.0; x += 2.5) {
+    const Eigen::Vector3d q(x, 0.002 * x * x / 10.0 + 0.7, 0.1);
+    const CatmullRomSpline::ClosestPoint a = whole.FindClosest(q), b = sub.FindClosest(q);
+    EXPECT_LT((a.point - b.point).norm(), 1e-9) << x;
+    EXPECT_EQ(a.segment, b.segment + static_cast<int>(first)) << x;
+  }
+  // Far from the curve: nothing; at an end: the end is in the range.
+  EXPECT_FALSE(ControlPointRangeNear(cps, {{300.0, 500.0, 0.0}}, 10.0, &first, &last));
+  ASSERT_TRUE(ControlPointRangeNear(cps, {{-5.0, 0.0, 0.0}}, 10.0, &first, &last));
+  EXPECT_EQ(first, 0u);
+  EXPECT_GE(last - first + 1, 4u);
+}
+
 }  // namespace
 }  // namespace ipm_road_mapper

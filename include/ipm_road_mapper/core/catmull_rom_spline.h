@@ -125,4 +125,17 @@ class CatmullRomSpline {
   std::vector<SegmentSamples> samples_;
 };
 
+// The control points of a long curve that matter near a region: [first, last] (inclusive
+// indices) span every control point within margin_m (x-y) of the axis-aligned box around
+// `points`, plus one on each side. A segment depends on its four control points only, so
+// segment k of CatmullRomSpline(c[first..last]) is segment first + k of the whole curve,
+// and with a margin above the control-point spacing every segment that passes through the
+// box is among them.
+// Queries near a region of a long lane (association, road direction) then cost what the
+// region needs, not the lane's length. Returns false when fewer than 4 control points
+// result (no part of the curve near the region, or a curve of < 4 points).
+bool ControlPointRangeNear(const std::vector<Eigen::Vector3d>& control_points,
+                           const std::vector<Eigen::Vector3d>& points, double margin_m,
+                           std::size_t* first, std::size_t* last);
+
 }  // namespace ipm_road_mapper
