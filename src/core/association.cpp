@@ -65,11 +65,19 @@ Eigen::Vector3d Mean(const std::array<Eigen::Vector3d, 4>& corners) {
 
 }  // namespace
 
+double MarkingFloorSigma(const AssociationOptions& options) {
+  return std::hypot(options.marking_position_sigma_m, options.odometry_sigma_m);
+}
+
+double LaneFloorSigma(const AssociationOptions& options) {
+  return std::hypot(options.lane_position_sigma_m, options.odometry_sigma_m);
+}
+
 double MarkingAssociationCost(const MarkingElement& element, const MarkingCandidate& candidate,
                               const AssociationOptions& options) {
   // Compare in x-y: the mapped z of a marking is refined later, the gate is planar.
   const Eigen::Vector2d d = (element.Center() - Mean(candidate.corners_map)).head<2>();
-  const double floor = options.marking_position_sigma_m * options.marking_position_sigma_m;
+  const double floor = std::pow(MarkingFloorSigma(options), 2);
   const Eigen::Matrix2d S =
       candidate.center_cov_map + element.center_cov_map + floor * Eigen::Matrix2d::Identity();
   return d.dot(S.ldlt().solve(d));
@@ -105,7 +113,9 @@ double LaneAssociationCost(const LaneElement& lane, const LaneCandidate& candida
     covs.push_back(candidate.cov_map.empty() ? Eigen::Matrix2d::Zero() : candidate.cov_map[i]);
   }
   if (points.size() < 2) return -1.0;
-  const double floor = options.lane_position_sigma_m * options.lane_position_sigma_m;
+  const double floor = std::pow(LaneFloorSigma(options), 2);
+  const double gate_m =
+      std::max(options.lane_gate_m, options.lane_gate_sigmas * LaneFloorSigma(options));
   // Only the part of the lane near the observation (a lane can be kilometers long); the
   // margin covers points past an end that still count.
   std::size_t first = 0, last = 0;
@@ -155,7 +165,7 @@ double LaneAssociationCost(const LaneElement& lane, const LaneCandidate& candida
   const std::size_t mid = lateral.size() / 2;
   std::nth_element(lateral.begin(), lateral.begin() + mid, lateral.end());
   std::nth_element(normalized.begin(), normalized.begin() + mid, normalized.end());
-  if (lateral[mid] > options.lane_gate_m || normalized[mid] > options.lane_gate_sigmas) return -1.0;
+  if (lateral[mid] > gate_m || normalized[mid] > options.lane_gate_sigmas) return -1.0;
   return normalized[mid];
 }
 

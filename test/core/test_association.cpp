@@ -99,8 +99,8 @@ TEST(AssociateLanes, IgnoresPointsMarkedUnusable) {
   candidate.usable.assign(candidate.points_map.size(), false);
   for (std::size_t i = 0; i < near; ++i) candidate.usable[i] = true;
   const AssociationOptions options;
-  EXPECT_NEAR(LaneAssociationCost(lanes[0], candidate, options),
-              0.1 / options.lane_position_sigma_m, 1e-6);
+  EXPECT_NEAR(LaneAssociationCost(lanes[0], candidate, options), 0.1 / LaneFloorSigma(options),
+              1e-6);
 }
 
 TEST(AssociateLanes, MatchesByLateralDistanceAndClass) {
@@ -128,6 +128,26 @@ TEST(AssociateLanes, LateralGateFollowsTheIpmCovariance) {
   LaneCandidate far = LinePoints(3, 6.5, 9, 14);
   far.cov_map.assign(far.points_map.size(), 100.0 * cov);
   EXPECT_EQ(AssociateLanes(lanes, {far}, AssociationOptions())[0], -1);
+}
+
+TEST(AssociateLanes, GatesWidenWithTheOdometrysNoise) {
+  // Odometry with 0.75 m of per-pose error: a frame's lane points 1.0 m off the lane are
+  // the same line (the default odometry's gates, 0.16 m floor and 1.2 m cap, refuse them
+  // in sigmas); a marking 1.5 m off likewise.
+  const std::vector<LaneElement> lanes = {StraightLane(2, 0.0, 0, 30)};
+  const LaneCandidate candidate = LinePoints(2, 1.0, 5, 25);
+  AssociationOptions options;
+  EXPECT_EQ(AssociateLanes(lanes, {candidate}, options)[0], -1);
+  options.odometry_sigma_m = 0.75;
+  EXPECT_EQ(AssociateLanes(lanes, {candidate}, options)[0], 0);
+  EXPECT_NEAR(LaneFloorSigma(options), std::hypot(0.05, 0.75), 1e-12);
+  // Beyond 3 of the widened sigmas: still refused.
+  EXPECT_EQ(AssociateLanes(lanes, {LinePoints(2, 2.5, 5, 25)}, options)[0], -1);
+
+  const std::vector<MarkingElement> markings = {Marking(10, 20.0, 0.0)};
+  MarkingCandidate shifted{10, Rectangle(21.5, 0.0, 3.0, 1.0), Eigen::Matrix2d::Zero()};
+  EXPECT_EQ(AssociateMarkings(markings, {shifted}, AssociationOptions())[0], -1);
+  EXPECT_EQ(AssociateMarkings(markings, {shifted}, options)[0], 0);
 }
 
 TEST(AssociateLanes, PointsPastTheEndExtendTheLane) {

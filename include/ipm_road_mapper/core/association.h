@@ -22,9 +22,10 @@ namespace ipm_road_mapper {
 // Gates of the association (config section `association`).
 struct AssociationOptions {
   double marking_gate_sigmas = 3.0;  // max Mahalanobis distance of the centers
-  // Isotropic floor of the gate's covariance (pose noise, shape, segmentation); crosswalk
-  // stripes 1 m apart must stay apart: 3 sigma of the floor is 0.75 m.
-  double marking_position_sigma_m = 0.25;
+  // Isotropic floor of the gate's covariance (shape, segmentation), to which the odometry's
+  // pose noise is added (MarkingFloorSigma); crosswalk stripes 1 m apart must stay apart:
+  // with the default odometry, 3 sigma of the floor is 0.75 m.
+  double marking_position_sigma_m = 0.2;
   // Two elements of one class whose centers come closer than this are merged (crosswalk
   // stripes are 1 m apart).
   double marking_merge_distance_m = 0.5;
@@ -35,14 +36,25 @@ struct AssociationOptions {
   // Lane points whose tr(Omega_p) exceeds this are not used to associate (or start) a lane:
   // far points of outer lines stray laterally by up to a meter.
   double lane_max_point_score_m2 = 1.0;
-  double lane_gate_m = 1.2;             // max median lateral distance to the lane (hard cap)
+  // Max median lateral distance to the lane (hard cap; raised to lane_gate_sigmas floor
+  // sigmas when the odometry is noisier than that).
+  double lane_gate_m = 1.2;
   double lane_gate_sigmas = 3.0;        // max median lateral distance in IPM sigmas (below)
-  double lane_position_sigma_m = 0.15;  // floor of a point's lateral sigma (pose, lane noise)
+  double lane_position_sigma_m = 0.05;  // floor of a point's lateral sigma (lane noise); + odometry
+  // The odometry's translation noise (m, x-y), added to both floors. Not read from the
+  // `association` section: the Mapper sets it from backend.pose_prior_sigma_trans_m, so a
+  // user states the odometry's noise once and every gate follows it (at 0.5 m of per-pose
+  // error, gates for 0.15 m split every lane into pieces).
+  double odometry_sigma_m = 0.15;
   double lane_min_direction_cos = 0.9;  // min |cos| between observation and lane directions
   double lane_max_end_gap_m = 15.0;     // points this far past a lane end still count (growth)
   double lane_min_support = 0.3;        // fraction of the observation's points that must count
   int spurious_after_frames = 10;       // element seen once, unseen for this many frames: dropped
 };
+
+// The gates' isotropic floors: the configured sigma and the odometry's, in quadrature.
+double MarkingFloorSigma(const AssociationOptions& options);
+double LaneFloorSigma(const AssociationOptions& options);
 
 // Reads the `association` section; throws OptionsError naming the bad key.
 AssociationOptions LoadAssociationOptions(OptionsReader reader);
