@@ -27,8 +27,7 @@ Mapper::Mapper(MapperOptions options, ClassTable classes,
       extrinsic_prior_(T_base_cam_initial, options_.backend.rotation_prior_sigma_rad,
                        options_.backend.translation_prior_sigma_m) {
   // The odometry's noise, stated once (backend.pose_prior_sigma_trans_m), widens every gate.
-  options_.association.odometry_sigma_m =
-      options_.backend.pose_prior_sigma_trans_m.head<2>().maxCoeff();
+  options_.association = EffectiveAssociationOptions(options_);
   if (options_.backend.enabled) backend_ = std::make_unique<Backend>(options_.backend);
 }
 

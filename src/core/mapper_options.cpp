@@ -85,6 +85,12 @@ MapperOptions LoadMapperOptionsFile(const std::string& path) {
   }
 }
 
+AssociationOptions EffectiveAssociationOptions(const MapperOptions& options) {
+  AssociationOptions association = options.association;
+  association.odometry_sigma_m = options.backend.pose_prior_sigma_trans_m.head<2>().maxCoeff();
+  return association;
+}
+
 std::string ToString(const MapperOptions& o) {
   std::ostringstream s;
   s << "method: " << o.method << "\n"
@@ -100,6 +106,9 @@ std::string ToString(const MapperOptions& o) {
     << "association.marking_position_sigma_m: " << o.association.marking_position_sigma_m << "\n"
     << "association.lane_max_point_score_m2: " << o.association.lane_max_point_score_m2 << "\n"
     << "association.lane_gate_m: " << o.association.lane_gate_m << "\n";
+  const AssociationOptions gates = EffectiveAssociationOptions(o);
+  s << "association floors (with the odometry's " << gates.odometry_sigma_m << " m): marking "
+    << MarkingFloorSigma(gates) << " m, lane " << LaneFloorSigma(gates) << " m\n";
   return s.str();
 }
 

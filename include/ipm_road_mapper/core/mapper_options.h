@@ -69,6 +69,10 @@ MapperOptions LoadMapperOptions(OptionsReader reader);
 // Loads a mapper config file; errors are prefixed with the file path.
 MapperOptions LoadMapperOptionsFile(const std::string& path);
 
+// The association options as the Mapper uses them: odometry_sigma_m taken from
+// backend.pose_prior_sigma_trans_m (x-y), so that the odometry's noise is stated once.
+AssociationOptions EffectiveAssociationOptions(const MapperOptions& options);
+
 // A multi-line, human-readable dump of the options (printed at start-up).
 std::string ToString(const MapperOptions& options);
 
