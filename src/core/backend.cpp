@@ -2,6 +2,8 @@
 
 #include <utility>
 
+#include "ipm_road_mapper/core/timing_series.h"
+
 namespace ipm_road_mapper {
 
 Backend::Backend(BackendOptions options) : options_(std::move(options)) {
@@ -64,7 +66,7 @@ void Backend::Publish(WindowResult result) {
   std::lock_guard<std::mutex> lock(mutex_);
   ++stats_.solved;
   if (!result.usable) ++stats_.unusable;
-  stats_.solve_times_s.push_back(result.solve_time_s);
+  AppendBounded(&stats_.solve_times_s, result.solve_time_s);
   results_.push_back(std::make_shared<const WindowResult>(std::move(result)));
 }
 

@@ -70,14 +70,6 @@ std::string Mapper::ValidateInput(const FrameInput& input) const {
   return "";
 }
 
-double FrontEndTiming::Quantile(std::vector<float> series, double q) {
-  if (series.empty()) return 0.0;
-  const std::size_t k =
-      std::min(series.size() - 1, static_cast<std::size_t>(q * static_cast<double>(series.size())));
-  std::nth_element(series.begin(), series.begin() + static_cast<std::ptrdiff_t>(k), series.end());
-  return series[k];
-}
-
 FrameStatus Mapper::ProcessFrame(const FrameInput& input, std::string* reason) {
   ++counters_.frames_received;
   const std::string error = ValidateInput(input);
@@ -99,7 +91,7 @@ FrameStatus Mapper::ProcessFrame(const FrameInput& input, std::string* reason) {
   FrameObservations observations =
       ExtractObservations(input.mask, classes_, ipm, options_.ipm.error_model, options_.extraction);
   counters_.extraction.Add(observations.counters);
-  frontend_timing_.extraction_ms.push_back(elapsed_ms(start));
+  AppendBounded(&frontend_timing_.extraction_ms, elapsed_ms(start));
 
   FrameRecord frame;
   frame.index = map_.frames.size();
@@ -113,7 +105,7 @@ FrameStatus Mapper::ProcessFrame(const FrameInput& input, std::string* reason) {
   MergeMarkings();
   AddLanes(observations, frame);
   DropSpurious(frame.index);
-  frontend_timing_.total_ms.push_back(elapsed_ms(start));
+  AppendBounded(&frontend_timing_.total_ms, elapsed_ms(start));
   ++counters_.frames_used;
   if (backend_ && counters_.frames_used % options_.backend.solve_every_n_frames == 0) {
     backend_->Submit(BuildSnapshot());
@@ -200,24 +192,16 @@ VectorMap Mapper::ExportMap() const {
   out.metadata["backend"] = backend_ ? ToString(options_.backend.lane_residual) : "off";
   out.metadata["backend_results_applied"] = counters_.results_applied;
   out.metadata["backend_results_rejected"] = counters_.results_rejected;
-  out.metadata["frontend_time_p50_ms"] = FrontEndTiming::Quantile(frontend_timing_.total_ms, 0.5);
-  out.metadata["frontend_time_p95_ms"] = FrontEndTiming::Quantile(frontend_timing_.total_ms, 0.95);
-  out.metadata["frontend_extraction_p50_ms"] =
-      FrontEndTiming::Quantile(frontend_timing_.extraction_ms, 0.5);
+  out.metadata["frontend_time_p50_ms"] = Quantile(frontend_timing_.total_ms, 0.5);
+  out.metadata["frontend_time_p95_ms"] = Quantile(frontend_timing_.total_ms, 0.95);
+  out.metadata["frontend_extraction_p50_ms"] = Quantile(frontend_timing_.extraction_ms, 0.5);
   if (backend_) {
     const BackendStats stats = backend_->stats();
-    std::vector<double> times = stats.solve_times_s;
-    std::sort(times.begin(), times.end());
-    auto quantile = [&times](double q) {
-      return times.empty()
-                 ? 0.0
-                 : times[std::min(times.size() - 1, static_cast<std::size_t>(q * times.size()))];
-    };
     out.metadata["backend_solves"] = stats.solved;
     out.metadata["backend_dropped_queue_full"] = stats.dropped_queue_full;
-    out.metadata["backend_solve_time_p50_s"] = quantile(0.5);
-    out.metadata["backend_solve_time_p95_s"] = quantile(0.95);
-    out.metadata["backend_solve_time_max_s"] = times.empty() ? 0.0 : times.back();
+    out.metadata["backend_solve_time_p50_s"] = Quantile(stats.solve_times_s, 0.5);
+    out.metadata["backend_solve_time_p95_s"] = Quantile(stats.solve_times_s, 0.95);
+    out.metadata["backend_solve_time_max_s"] = Quantile(stats.solve_times_s, 1.0);
   }
   return out;
 }

@@ -173,10 +173,9 @@ std::string FrontEndLine(const Mapper& mapper) {
   std::ostringstream s;
   s.setf(std::ios::fixed);
   s.precision(2);
-  s << "front end: " << FrontEndTiming::Quantile(t.total_ms, 0.5) << " ms/frame median, "
-    << FrontEndTiming::Quantile(t.total_ms, 0.95) << " ms p95, "
-    << FrontEndTiming::Quantile(t.total_ms, 1.0) << " ms max (extraction "
-    << FrontEndTiming::Quantile(t.extraction_ms, 0.5) << " ms median)";
+  s << "front end: " << Quantile(t.total_ms, 0.5) << " ms/frame median, "
+    << Quantile(t.total_ms, 0.95) << " ms p95, " << Quantile(t.total_ms, 1.0)
+    << " ms max (extraction " << Quantile(t.extraction_ms, 0.5) << " ms median)";
   return s.str();
 }
 

@@ -25,7 +25,7 @@ struct BackendStats {
   std::uint64_t solved = 0;
   std::uint64_t dropped_queue_full = 0;  // oldest waiting window replaced by a newer one
   std::uint64_t unusable = 0;            // solver failure or trust bound
-  std::vector<double> solve_times_s;     // one per solve
+  std::vector<double> solve_times_s;     // one per solve, the most recent (timing_series.h)
 };
 
 class Backend {

@@ -20,6 +20,7 @@
 #include "ipm_road_mapper/core/pinhole_camera.h"
 #include "ipm_road_mapper/core/road_map.h"
 #include "ipm_road_mapper/core/road_surface.h"
+#include "ipm_road_mapper/core/timing_series.h"
 #include "ipm_road_mapper/core/vector_map.h"
 
 namespace ipm_road_mapper {
@@ -57,12 +58,11 @@ struct MapperCounters {
 };
 
 // Wall time of the front end per used frame (mask -> observations -> map update; the
-// back end's snapshot and merges excluded), for the summaries and the benchmark.
+// back end's snapshot and merges excluded), for the summaries and the benchmark; the most
+// recent frames only (timing_series.h).
 struct FrontEndTiming {
   std::vector<float> extraction_ms;  // mask -> instances -> IPM measurements
   std::vector<float> total_ms;       // extraction + orientation, association, map update
-  // The q-quantile (0..1) of a series; 0 when empty.
-  static double Quantile(std::vector<float> series, double q);
 };
 
 // The mapper: the front end runs in the caller's thread; with options.backend.enabled it
