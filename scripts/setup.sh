@@ -39,7 +39,10 @@ fi
 mkdir -p "$build/devel/lib/python3/dist-packages"
 if [ ! -f "$build/CMakeCache.txt" ]; then
   log "configuring into $build"
-  cmake -S "$repo" -B "$build" -DCMAKE_BUILD_TYPE=Release \
+  # ccache, when installed, makes a rebuild in a fresh build folder fast.
+  launcher=()
+  command -v ccache >/dev/null && launcher=(-DCMAKE_CXX_COMPILER_LAUNCHER=ccache)
+  cmake -S "$repo" -B "$build" -DCMAKE_BUILD_TYPE=Release "${launcher[@]}" ${IRM_CMAKE_ARGS:-} \
     -DCATKIN_DEVEL_PREFIX="$build/devel" \
     -DPYTHON_EXECUTABLE=/usr/bin/python3 -DPython3_EXECUTABLE=/usr/bin/python3 >"$build/configure.log" 2>&1 \
     || { cat "$build/configure.log"; exit 1; }

@@ -7,7 +7,7 @@
 #include <cmath>
 #include <utility>
 
-#include "ipm_road_mapper/core/debug_overlay.h"
+#include "ipm_road_mapper/pipeline/debug_overlay.h"
 #include "ipm_road_mapper/ros/msg_conversion.h"
 
 namespace ipm_road_mapper {

@@ -6,7 +6,7 @@
 #include <cmath>
 #include <numeric>
 
-#include "ipm_road_mapper/core/rigid_transform.h"
+#include "ipm_road_mapper/core/geometry/rigid_transform.h"
 
 namespace ipm_road_mapper {
 namespace {

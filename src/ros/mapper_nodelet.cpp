@@ -8,8 +8,8 @@
 #include <pluginlib/class_list_macros.hpp>
 #include <utility>
 
-#include "ipm_road_mapper/ros/extrinsic_source.h"
-#include "ipm_road_mapper/ros/map_files.h"
+#include "ipm_road_mapper/pipeline/extrinsic_source.h"
+#include "ipm_road_mapper/pipeline/map_files.h"
 #include "ipm_road_mapper/ros/msg_conversion.h"
 #include "ipm_road_mapper/ros/param_bridge.h"
 

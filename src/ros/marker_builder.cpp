@@ -5,7 +5,7 @@
 #include <exception>
 #include <vector>
 
-#include "ipm_road_mapper/core/catmull_rom_spline.h"
+#include "ipm_road_mapper/core/geometry/catmull_rom_spline.h"
 #include "ipm_road_mapper/ros/msg_conversion.h"
 
 namespace ipm_road_mapper {

@@ -16,9 +16,9 @@
 #include <stdexcept>
 #include <string>
 
-#include "ipm_road_mapper/core/evaluation.h"
-#include "ipm_road_mapper/core/ground_truth.h"
-#include "ipm_road_mapper/core/vector_map.h"
+#include "ipm_road_mapper/eval/evaluation.h"
+#include "ipm_road_mapper/core/io/ground_truth.h"
+#include "ipm_road_mapper/core/map/vector_map.h"
 
 namespace {
 

@@ -23,10 +23,10 @@
 #include <map>
 #include <string>
 
-#include "ipm_road_mapper/core/ground_truth.h"
-#include "ipm_road_mapper/core/sim/drive_simulator.h"
-#include "ipm_road_mapper/core/sim/ipm_check.h"
-#include "ipm_road_mapper/core/vector_map.h"
+#include "ipm_road_mapper/core/io/ground_truth.h"
+#include "ipm_road_mapper/sim/drive_simulator.h"
+#include "ipm_road_mapper/sim/ipm_check.h"
+#include "ipm_road_mapper/core/map/vector_map.h"
 
 namespace irm = ipm_road_mapper;
 namespace fs = std::filesystem;

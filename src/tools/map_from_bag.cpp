@@ -38,19 +38,19 @@
 #include <stdexcept>
 #include <string>
 
-#include "ipm_road_mapper/core/frame_assembler.h"
-#include "ipm_road_mapper/core/geojson_export.h"
-#include "ipm_road_mapper/core/mapper.h"
-#include "ipm_road_mapper/core/rigid_transform.h"
-#include "ipm_road_mapper/core/vector_map.h"
+#include "ipm_road_mapper/pipeline/frame_assembler.h"
+#include "ipm_road_mapper/core/io/geojson_export.h"
+#include "ipm_road_mapper/core/mapper/mapper.h"
+#include "ipm_road_mapper/core/geometry/rigid_transform.h"
+#include "ipm_road_mapper/core/map/vector_map.h"
 #include "ipm_road_mapper/ros/bag_input.h"
 #include "ipm_road_mapper/ros/bag_prefetcher.h"
-#include "ipm_road_mapper/ros/extrinsic_source.h"
-#include "ipm_road_mapper/ros/map_files.h"
-#include "ipm_road_mapper/ros/mapper_config.h"
-#include "ipm_road_mapper/ros/mapping_session.h"
+#include "ipm_road_mapper/pipeline/extrinsic_source.h"
+#include "ipm_road_mapper/pipeline/map_files.h"
+#include "ipm_road_mapper/pipeline/mapper_config.h"
+#include "ipm_road_mapper/pipeline/mapping_session.h"
 #include "ipm_road_mapper/ros/msg_conversion.h"
-#include "ipm_road_mapper/ros/progress_meter.h"
+#include "ipm_road_mapper/pipeline/progress_meter.h"
 
 namespace ipm_road_mapper {
 namespace {

@@ -2,7 +2,7 @@
 
 #include <cmath>
 
-#include "ipm_road_mapper/core/association.h"
+#include "ipm_road_mapper/core/frontend/association.h"
 
 namespace ipm_road_mapper {
 namespace {

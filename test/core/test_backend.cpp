@@ -5,9 +5,9 @@
 
 #include <random>
 
-#include "ipm_road_mapper/core/backend.h"
-#include "ipm_road_mapper/core/ipm.h"
-#include "ipm_road_mapper/core/rigid_transform.h"
+#include "ipm_road_mapper/core/backend/backend.h"
+#include "ipm_road_mapper/core/geometry/ipm.h"
+#include "ipm_road_mapper/core/geometry/rigid_transform.h"
 
 namespace ipm_road_mapper {
 namespace {

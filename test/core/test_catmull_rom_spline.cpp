@@ -7,7 +7,7 @@
 #include <stdexcept>
 #include <vector>
 
-#include "ipm_road_mapper/core/catmull_rom_spline.h"
+#include "ipm_road_mapper/core/geometry/catmull_rom_spline.h"
 
 namespace ipm_road_mapper {
 namespace {

@@ -6,12 +6,12 @@
 
 #include <random>
 
-#include "ipm_road_mapper/core/extrinsic_marginalization.h"
-#include "ipm_road_mapper/core/extrinsic_prior.h"
-#include "ipm_road_mapper/core/residuals/corner_reprojection_residual.h"
-#include "ipm_road_mapper/core/residuals/extrinsic_prior_residual.h"
-#include "ipm_road_mapper/core/residuals/road_surface_prior_residual.h"
-#include "ipm_road_mapper/core/rigid_transform.h"
+#include "ipm_road_mapper/core/backend/extrinsic_marginalization.h"
+#include "ipm_road_mapper/core/backend/extrinsic_prior.h"
+#include "ipm_road_mapper/core/backend/residuals/corner_reprojection_residual.h"
+#include "ipm_road_mapper/core/backend/residuals/extrinsic_prior_residual.h"
+#include "ipm_road_mapper/core/backend/residuals/road_surface_prior_residual.h"
+#include "ipm_road_mapper/core/geometry/rigid_transform.h"
 
 namespace ipm_road_mapper {
 namespace {

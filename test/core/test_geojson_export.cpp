@@ -10,7 +10,7 @@
 #include <fstream>
 #include <string>
 
-#include "ipm_road_mapper/core/geojson_export.h"
+#include "ipm_road_mapper/core/io/geojson_export.h"
 
 namespace ipm_road_mapper {
 namespace {

@@ -10,9 +10,9 @@
 #include <string>
 #include <vector>
 
-#include "ipm_road_mapper/core/instance_extraction.h"
-#include "../../src/core/instance_extraction_runs.h"  // BoundingRectangle
-#include "mask_test_utils.h"
+#include "ipm_road_mapper/core/frontend/instance_extraction.h"
+#include "../../src/core/frontend/instance_extraction_runs.h"  // BoundingRectangle
+#include "common/mask_test_utils.h"
 
 namespace ipm_road_mapper {
 namespace {

@@ -7,8 +7,8 @@
 #include <ostream>
 #include <string>
 
-#include "ipm_road_mapper/core/ipm.h"
-#include "ipm_road_mapper/core/rigid_transform.h"
+#include "ipm_road_mapper/core/geometry/ipm.h"
+#include "ipm_road_mapper/core/geometry/rigid_transform.h"
 
 namespace ipm_road_mapper {
 namespace {

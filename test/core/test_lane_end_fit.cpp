@@ -5,8 +5,8 @@
 #include <cmath>
 #include <random>
 
-#include "ipm_road_mapper/core/catmull_rom_spline.h"
-#include "ipm_road_mapper/core/lane_end_fit.h"
+#include "ipm_road_mapper/core/geometry/catmull_rom_spline.h"
+#include "ipm_road_mapper/core/geometry/lane_end_fit.h"
 
 namespace ipm_road_mapper {
 namespace {

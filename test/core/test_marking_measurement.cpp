@@ -4,8 +4,8 @@
 
 #include <cmath>
 
-#include "ipm_road_mapper/core/marking_measurement.h"
-#include "ipm_road_mapper/core/rigid_transform.h"
+#include "ipm_road_mapper/core/frontend/marking_measurement.h"
+#include "ipm_road_mapper/core/geometry/rigid_transform.h"
 
 namespace ipm_road_mapper {
 namespace {

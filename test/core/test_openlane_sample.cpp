@@ -28,9 +28,9 @@
 #include <string>
 #include <vector>
 
-#include "ipm_road_mapper/core/ipm.h"
-#include "ipm_road_mapper/core/pinhole_camera.h"
-#include "ipm_road_mapper/core/rigid_transform.h"
+#include "ipm_road_mapper/core/geometry/ipm.h"
+#include "ipm_road_mapper/core/geometry/pinhole_camera.h"
+#include "ipm_road_mapper/core/geometry/rigid_transform.h"
 
 namespace ipm_road_mapper {
 namespace {

@@ -9,7 +9,7 @@
 #include <opencv2/core.hpp>
 #include <vector>
 
-#include "ipm_road_mapper/core/pinhole_camera.h"
+#include "ipm_road_mapper/core/geometry/pinhole_camera.h"
 
 namespace ipm_road_mapper {
 namespace {

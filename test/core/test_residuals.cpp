@@ -14,18 +14,18 @@
 #include <memory>
 #include <vector>
 
-#include "ipm_road_mapper/core/catmull_rom_spline.h"
-#include "ipm_road_mapper/core/ipm.h"
-#include "ipm_road_mapper/core/pinhole_camera.h"
-#include "ipm_road_mapper/core/residuals/corner_reprojection_residual.h"
-#include "ipm_road_mapper/core/residuals/lane_smoothness_residual.h"
-#include "ipm_road_mapper/core/residuals/motion_prior_residual.h"
-#include "ipm_road_mapper/core/residuals/pose_prior_residual.h"
-#include "ipm_road_mapper/core/residuals/ppsr_residual.h"
-#include "ipm_road_mapper/core/residuals/projection.h"
-#include "ipm_road_mapper/core/residuals/psr_residual.h"
-#include "ipm_road_mapper/core/residuals/translation_prior_residual.h"
-#include "ipm_road_mapper/core/rigid_transform.h"
+#include "ipm_road_mapper/core/geometry/catmull_rom_spline.h"
+#include "ipm_road_mapper/core/geometry/ipm.h"
+#include "ipm_road_mapper/core/geometry/pinhole_camera.h"
+#include "ipm_road_mapper/core/backend/residuals/corner_reprojection_residual.h"
+#include "ipm_road_mapper/core/backend/residuals/lane_smoothness_residual.h"
+#include "ipm_road_mapper/core/backend/residuals/motion_prior_residual.h"
+#include "ipm_road_mapper/core/backend/residuals/pose_prior_residual.h"
+#include "ipm_road_mapper/core/backend/residuals/ppsr_residual.h"
+#include "ipm_road_mapper/core/backend/residuals/projection.h"
+#include "ipm_road_mapper/core/backend/residuals/psr_residual.h"
+#include "ipm_road_mapper/core/backend/residuals/translation_prior_residual.h"
+#include "ipm_road_mapper/core/geometry/rigid_transform.h"
 
 namespace ipm_road_mapper {
 namespace residuals {

@@ -11,7 +11,7 @@
 #include <string>
 #include <unsupported/Eigen/MatrixFunctions>
 
-#include "ipm_road_mapper/core/rigid_transform.h"
+#include "ipm_road_mapper/core/geometry/rigid_transform.h"
 
 namespace ipm_road_mapper {
 namespace {

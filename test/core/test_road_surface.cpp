@@ -5,9 +5,9 @@
 
 #include <cmath>
 
-#include "ipm_road_mapper/core/residuals/pose_uncertainty.h"
-#include "ipm_road_mapper/core/rigid_transform.h"
-#include "ipm_road_mapper/core/road_surface.h"
+#include "ipm_road_mapper/core/backend/residuals/pose_uncertainty.h"
+#include "ipm_road_mapper/core/geometry/rigid_transform.h"
+#include "ipm_road_mapper/core/geometry/road_surface.h"
 
 namespace ipm_road_mapper {
 namespace {

@@ -8,8 +8,8 @@
 #include <utility>
 #include <vector>
 
-#include "ipm_road_mapper/core/catmull_rom_spline.h"
-#include "ipm_road_mapper/core/spline_fitting.h"
+#include "ipm_road_mapper/core/geometry/catmull_rom_spline.h"
+#include "ipm_road_mapper/core/geometry/spline_fitting.h"
 
 namespace ipm_road_mapper {
 namespace {

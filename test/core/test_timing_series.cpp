@@ -4,7 +4,7 @@
 
 #include <vector>
 
-#include "ipm_road_mapper/core/timing_series.h"
+#include "ipm_road_mapper/core/mapper/timing_series.h"
 
 namespace ipm_road_mapper {
 namespace {

@@ -13,8 +13,8 @@
 #include <sstream>
 #include <string>
 
-#include "ipm_road_mapper/core/ground_truth.h"
-#include "ipm_road_mapper/core/vector_map.h"
+#include "ipm_road_mapper/core/io/ground_truth.h"
+#include "ipm_road_mapper/core/map/vector_map.h"
 
 namespace ipm_road_mapper {
 namespace {

@@ -10,9 +10,9 @@
 #include <string>
 #include <vector>
 
-#include "ipm_road_mapper/core/class_table.h"
-#include "ipm_road_mapper/core/mapper_options.h"
-#include "ipm_road_mapper/core/yaml_options.h"
+#include "ipm_road_mapper/core/frontend/class_table.h"
+#include "ipm_road_mapper/core/mapper/mapper_options.h"
+#include "ipm_road_mapper/core/io/yaml_options.h"
 
 namespace ipm_road_mapper {
 namespace {

@@ -12,7 +12,7 @@
 #include <utility>
 #include <vector>
 
-#include "ipm_road_mapper/core/pinhole_camera.h"
+#include "ipm_road_mapper/core/geometry/pinhole_camera.h"
 
 namespace ipm_road_mapper {
 

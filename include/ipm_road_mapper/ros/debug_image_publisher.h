@@ -16,10 +16,10 @@
 #include <optional>
 #include <string>
 
-#include "ipm_road_mapper/core/class_table.h"
-#include "ipm_road_mapper/core/mapper.h"
-#include "ipm_road_mapper/core/mapper_options.h"
-#include "ipm_road_mapper/core/vector_map.h"
+#include "ipm_road_mapper/core/frontend/class_table.h"
+#include "ipm_road_mapper/core/mapper/mapper.h"
+#include "ipm_road_mapper/core/mapper/mapper_options.h"
+#include "ipm_road_mapper/core/map/vector_map.h"
 
 namespace ipm_road_mapper {
 

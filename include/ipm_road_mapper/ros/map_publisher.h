@@ -12,7 +12,7 @@
 #include <optional>
 #include <string>
 
-#include "ipm_road_mapper/core/vector_map.h"
+#include "ipm_road_mapper/core/map/vector_map.h"
 #include "ipm_road_mapper/ros/marker_builder.h"
 
 namespace ipm_road_mapper {

@@ -21,9 +21,9 @@
 #include <mutex>
 #include <string>
 
-#include "ipm_road_mapper/core/backend.h"
-#include "ipm_road_mapper/core/frame_assembler.h"
-#include "ipm_road_mapper/core/mapper.h"
+#include "ipm_road_mapper/core/backend/backend.h"
+#include "ipm_road_mapper/pipeline/frame_assembler.h"
+#include "ipm_road_mapper/core/mapper/mapper.h"
 
 namespace ipm_road_mapper {
 

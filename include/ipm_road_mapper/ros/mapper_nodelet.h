@@ -42,9 +42,9 @@
 #include "ipm_road_mapper/SaveMap.h"
 #include "ipm_road_mapper/ros/debug_image_publisher.h"
 #include "ipm_road_mapper/ros/map_publisher.h"
-#include "ipm_road_mapper/ros/mapper_config.h"
+#include "ipm_road_mapper/pipeline/mapper_config.h"
 #include "ipm_road_mapper/ros/mapper_diagnostics.h"
-#include "ipm_road_mapper/ros/mapping_session.h"
+#include "ipm_road_mapper/pipeline/mapping_session.h"
 
 namespace ipm_road_mapper {
 

@@ -16,7 +16,7 @@
 #include <string>
 #include <utility>
 
-#include "ipm_road_mapper/core/vector_map.h"
+#include "ipm_road_mapper/core/map/vector_map.h"
 
 namespace ipm_road_mapper {
 

@@ -17,8 +17,8 @@
 #include <opencv2/core.hpp>
 #include <string>
 
-#include "ipm_road_mapper/core/pinhole_camera.h"
-#include "ipm_road_mapper/core/rigid_transform.h"
+#include "ipm_road_mapper/core/geometry/pinhole_camera.h"
+#include "ipm_road_mapper/core/geometry/rigid_transform.h"
 
 namespace ipm_road_mapper {
 

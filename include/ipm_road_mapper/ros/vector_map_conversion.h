@@ -8,8 +8,8 @@
 #include <string>
 #include <vector>
 
-#include "ipm_road_mapper/core/rigid_transform.h"
-#include "ipm_road_mapper/core/vector_map.h"
+#include "ipm_road_mapper/core/geometry/rigid_transform.h"
+#include "ipm_road_mapper/core/map/vector_map.h"
 #include "ipm_road_mapper/ros/vector_map_msg.h"
 
 namespace ipm_road_mapper {

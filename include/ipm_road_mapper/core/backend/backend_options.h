@@ -1,0 +1,87 @@
+// Options of the back end (config section `backend`): what is optimized, the residual
+// weights and robust kernel, the sliding window, the alternation and the trust bound. The
+// ablation rows of the paper are combinations of these switches (config/ablations/).
+#pragma once
+
+#include <Eigen/Core>
+#include <string>
+
+#include "ipm_road_mapper/core/io/yaml_options.h"
+
+namespace ipm_road_mapper {
+
+// How lane control points are refined.
+enum class LaneResidual {
+  kNone,  // not optimized: control points re-estimated by g from re-IPMed selected points
+  kPsr,   // point-to-spline residual on IPM points (ablation)
+  kPpsr,  // projected point-to-spline residual on pixels (the paper's method)
+};
+
+const char* ToString(LaneResidual residual);
+
+struct BackendOptions {
+  bool enabled = true;             // false: plain IPM front end only
+  bool synchronous = false;        // solve in the caller's thread (offline determinism)
+  bool optimize_extrinsic = true;  // R_base_cam, t_base_cam free in the map step
+  bool optimize_markings = true;   // marking corners free in the map step
+  bool optimize_z = true;          // z of corners and control points free
+  bool pose_update = true;         // run the pose-update step
+  LaneResidual lane_residual = LaneResidual::kPpsr;
+  int window_frames = 40;               // frames whose observations enter a solve
+  int solve_every_n_frames = 5;         // how often the front end hands a window over
+  int rounds = 2;                       // map+extrinsic <-> pose alternations per solve
+  int max_iterations = 10;              // Ceres iterations per step
+  int queue_size = 2;                   // windows waiting for the optimizer thread
+  double pixel_sigma_px = 2.0;          // corner and PPSR measurement sigma
+  double psr_sigma_m = 0.2;             // PSR (3D) measurement sigma
+  std::string robust_kernel = "huber";  // huber, cauchy or none
+  double robust_scale = 2.0;            // kernel scale in whitened units (sigmas)
+  Eigen::Vector3d translation_prior_sigma_m{0.02, 0.02, 0.02};
+  // Prior of the extrinsic rotation on its rough value, per base_link axis (roll, pitch,
+  // yaw): roll is unobservable on straight roads, pitch and yaw are observable.
+  Eigen::Vector3d rotation_prior_sigma_rad{0.1 * M_PI / 180.0, 3.0 * M_PI / 180.0,
+                                           3.0 * M_PI / 180.0};
+  Eigen::Vector3d pose_prior_sigma_trans_m{0.3, 0.3, 0.05};        // base_link x, y, z
+  Eigen::Vector3d pose_prior_sigma_rot_rad{0.001, 0.001, 0.0052};  // roll, pitch, yaw
+  double max_extrinsic_change_rad = 2.0 * M_PI / 180.0;            // trust bound per solve
+  double max_extrinsic_change_m = 0.2;
+  int max_lane_points_per_observation = 6;  // PPSR/PSR pixels per lane observation
+  int max_measurements_per_marking = 10;    // observations of a marking per solve (spread)
+  // Road-surface prior of free map points (with optimize_z): the height of a point in
+  // base_link of the window frame horizontally closest to it is ~0, with sigma
+  // hypot(road_height_sigma_m, road_height_sigma_per_m * distance). base_link's origin is on
+  // the road, so the road is known at the wheels and less so ahead of them (grade, waves).
+  // Without it a lane seen from a camera driving along it slides freely in the plane
+  // through the camera path (height against lateral offset), and the extrinsic roll about
+  // the direction of travel is unobservable.
+  double road_height_sigma_m = 0.02;
+  double road_height_sigma_per_m = 0.01;
+  // The road's plane at a point averages the frames that drove within this radius of it
+  // (road_surface.h: the body's pitch oscillation averages out over a period, ~10 m).
+  double road_plane_radius_m = 6.0;
+  // Anchor of each free lane control point to its value at the start of a solve
+  // (along_lane_anchor_residual.h): tight along the lane (PPSR leaves that free), loose
+  // across it.
+  double lane_anchor_along_sigma_m = 0.05;
+  double lane_anchor_across_sigma_m = 0.5;
+  // Second differences of consecutive control points (lane_smoothness_residual.h); 0: off.
+  double lane_smoothness_sigma_m = 0.2;
+  // The map + extrinsic step weighs each measurement with the pixel sigma and the frame's
+  // pose uncertainty: the pose prior's sigmas times this (0: poses taken as exact).
+  double map_step_pose_sigma_scale = 0.3;
+  // Motion prior of the pose step (motion_prior_residual.h): finite-difference accelerations
+  // of consecutive poses, per base_link axis.
+  bool motion_prior = true;
+  Eigen::Vector3d motion_sigma_acc_mps2{1.0, 1.0, 2.0};            // x y z
+  Eigen::Vector3d motion_sigma_angular_acc_radps2{0.5, 0.5, 0.2};  // roll pitch yaw
+  // At the end of input, one solve over the whole drive (Mapper::Finish), when it has at
+  // most final_global_max_frames frames; final_global_rounds alternations.
+  bool final_global_solve = true;
+  int final_global_max_frames = 3000;
+  int final_global_rounds = 3;
+};
+
+// Reads the `backend` section; throws OptionsError naming the bad key.
+BackendOptions LoadBackendOptions(OptionsReader reader);
+
+}  // namespace ipm_road_mapper

@@ -1,0 +1,94 @@
+// One solve of the back end over a sliding window (DESIGN.md §4, paper "Map Optimization"
+// and "Pose Update"): a copied snapshot of the window goes in, the optimized state comes
+// out; the live map is never touched here. Each round alternates
+//   1. map + extrinsic step: marking corners, lane control points, R_base_cam, t_base_cam
+//      free; the window's poses constant (which also fixes the gauge: the map is anchored
+//      to the odometry frame through them). Corner reprojection + PPSR (or PSR) residuals,
+//      the translation prior on t_base_cam, a weak along-lane anchor per control point.
+//   2. pose step: the window's poses free; map and extrinsic constant. The same residuals
+//      plus a prior of each pose on its odometry. (Both at once make camera and vehicle
+//      motion fight, as the paper notes.)
+#pragma once
+
+#include <Eigen/Geometry>
+#include <array>
+#include <cstdint>
+#include <string>
+#include <vector>
+
+#include "ipm_road_mapper/core/backend/backend_options.h"
+#include "ipm_road_mapper/core/backend/extrinsic_prior.h"
+#include "ipm_road_mapper/core/geometry/pinhole_camera.h"
+#include "ipm_road_mapper/core/map/road_map.h"
+
+namespace ipm_road_mapper {
+
+// A frame of the window: its current pose estimate and its odometry (the prior).
+struct WindowFrame {
+  std::size_t index = 0;
+  Eigen::Isometry3d T_map_base = Eigen::Isometry3d::Identity();
+  Eigen::Isometry3d T_map_base_odom = Eigen::Isometry3d::Identity();
+  // In the window: its pose is free in the pose step. Otherwise a context frame (older
+  // measurements of the window's elements were made from it): its pose is data.
+  bool in_window = true;
+  double stamp = 0.0;  // s (the motion prior's time steps)
+};
+
+// A marking observed in the window, with its in-window measurements.
+struct WindowMarking {
+  std::uint64_t id = 0;
+  std::array<Eigen::Vector3d, 4> corners_map;
+  std::vector<MarkingMeasurement> measurements;
+  // The road's direction at the marking (tangent of the nearest lane; zero: unknown), along
+  // which its corners are re-measured.
+  Eigen::Vector3d axis_map = Eigen::Vector3d::Zero();
+  // Its estimate is settled (through an earlier solve, seen from near): only such a marking
+  // corrects poses (a new one is where flat-ground IPM put it, meters off, and poses
+  // aligned to it would drift with it).
+  bool mature = false;
+};
+
+// A lane observed in the window. `first_cp_index` is the lane's global index of
+// control_points_map[0] (it decreases when the lane grows at its start), so a result can be
+// applied to a lane that grew meanwhile.
+struct WindowLane {
+  std::uint64_t id = 0;
+  std::int64_t first_cp_index = 0;
+  std::vector<Eigen::Vector3d> control_points_map;
+  std::vector<LaneMeasurement> measurements;
+};
+
+// What the front end hands to the optimizer.
+struct WindowSnapshot {
+  std::uint64_t sequence = 0;
+  CameraIntrinsics camera;
+  Eigen::Isometry3d T_base_cam = Eigen::Isometry3d::Identity();
+  // What retired data (and the mounting prior) say about the extrinsic.
+  ExtrinsicPrior extrinsic_prior;
+  std::vector<WindowFrame> frames;  // sorted by index: the window and its context frames
+  std::vector<WindowMarking> markings;
+  std::vector<WindowLane> lanes;
+};
+
+// What the optimizer hands back (immutable once published).
+struct WindowResult {
+  std::uint64_t sequence = 0;
+  bool usable = false;  // Ceres says the solution is usable and the trust bound holds
+  std::string reason;   // why not usable
+  Eigen::Isometry3d T_base_cam = Eigen::Isometry3d::Identity();
+  std::vector<WindowFrame> frames;
+  std::vector<WindowMarking> markings;  // measurements left empty
+  std::vector<WindowLane> lanes;        // measurements left empty
+  double extrinsic_change_rad = 0.0;
+  double extrinsic_change_m = 0.0;
+  double solve_time_s = 0.0;
+  int residual_blocks = 0;
+  int iterations = 0;
+  double initial_cost = 0.0, final_cost = 0.0;
+  std::string summary;  // Ceres BriefReport of the last step
+};
+
+// Builds and solves the window's alternating problem.
+WindowResult SolveWindow(const WindowSnapshot& snapshot, const BackendOptions& options);
+
+}  // namespace ipm_road_mapper

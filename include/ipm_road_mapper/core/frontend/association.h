@@ -1,0 +1,105 @@
+// Data association of one frame's observations with the map's elements: gated and
+// class-aware, one-to-one within a frame (greedy by increasing cost).
+//  - markings: Mahalanobis distance of the centers in x-y, with the covariance of plain IPM
+//    at each (Omega_p: at 20 m a pitch error of 0.3 deg moves a marking 1.4 m along the
+//    road but 4 cm across it) plus an isotropic floor; then the best cyclic order of the
+//    corners;
+//  - lanes: lateral distance of the observation's points to the element's spline (or to
+//    its end tangent, for points just past an end), in units of each point's lateral IPM
+//    sigma (outer lines seen at 10 m stray by +-0.5 m as the body pitches), and direction
+//    agreement.
+#pragma once
+
+#include <Eigen/Core>
+#include <array>
+#include <vector>
+
+#include "ipm_road_mapper/core/map/road_map.h"
+#include "ipm_road_mapper/core/io/yaml_options.h"
+
+namespace ipm_road_mapper {
+
+// Gates of the association (config section `association`).
+struct AssociationOptions {
+  double marking_gate_sigmas = 3.0;  // max Mahalanobis distance of the centers
+  // Isotropic floor of the gate's covariance (shape, segmentation), to which the odometry's
+  // pose noise is added (MarkingFloorSigma); crosswalk stripes 1 m apart must stay apart:
+  // with the default odometry, 3 sigma of the floor is 0.75 m.
+  double marking_position_sigma_m = 0.2;
+  // Two elements of one class whose centers come closer than this are merged (crosswalk
+  // stripes are 1 m apart).
+  double marking_merge_distance_m = 0.5;
+  // ... or whose ground rectangles overlap by at least this fraction of the smaller one's
+  // area (a marking seen as two, e.g. a close-range view that missed its element; real
+  // markings do not overlap). 0 = off.
+  double marking_merge_overlap = 0.5;
+  // Lane points whose tr(Omega_p) exceeds this are not used to associate (or start) a lane:
+  // far points of outer lines stray laterally by up to a meter.
+  double lane_max_point_score_m2 = 1.0;
+  // Max median lateral distance to the lane (hard cap; raised to lane_gate_sigmas floor
+  // sigmas when the odometry is noisier than that).
+  double lane_gate_m = 1.2;
+  double lane_gate_sigmas = 3.0;        // max median lateral distance in IPM sigmas (below)
+  double lane_position_sigma_m = 0.05;  // floor of a point's lateral sigma (lane noise); + odometry
+  // The odometry's translation noise (m, x-y), added to both floors. Not read from the
+  // `association` section: the Mapper sets it from backend.pose_prior_sigma_trans_m, so a
+  // user states the odometry's noise once and every gate follows it (at 0.5 m of per-pose
+  // error, gates for 0.15 m split every lane into pieces).
+  double odometry_sigma_m = 0.15;
+  double lane_min_direction_cos = 0.9;  // min |cos| between observation and lane directions
+  double lane_max_end_gap_m = 15.0;     // points this far past a lane end still count (growth)
+  double lane_min_support = 0.3;        // fraction of the observation's points that must count
+  int spurious_after_frames = 10;       // element seen once, unseen for this many frames: dropped
+};
+
+// The gates' isotropic floors: the configured sigma and the odometry's, in quadrature.
+double MarkingFloorSigma(const AssociationOptions& options);
+double LaneFloorSigma(const AssociationOptions& options);
+
+// Reads the `association` section; throws OptionsError naming the bad key.
+AssociationOptions LoadAssociationOptions(OptionsReader reader);
+
+// The cyclic shift s minimizing sum_i |element[i] - observation[(i + s) % 4]|; writes the
+// mean corner distance of that order to *mean_distance_m.
+int BestCyclicShift(const std::array<Eigen::Vector3d, 4>& element,
+                    const std::array<Eigen::Vector3d, 4>& observation, double* mean_distance_m);
+
+// A marking observation in the map frame, for association.
+struct MarkingCandidate {
+  int class_id = 0;
+  std::array<Eigen::Vector3d, 4> corners_map;
+  Eigen::Matrix2d center_cov_map = Eigen::Matrix2d::Zero();  // Omega_p (x-y) in the map frame
+};
+
+// Squared Mahalanobis distance of a candidate's center from an element's, in x-y.
+double MarkingAssociationCost(const MarkingElement& element, const MarkingCandidate& candidate,
+                              const AssociationOptions& options);
+
+// For each candidate, the index of its marking element or -1 (new element).
+std::vector<int> AssociateMarkings(const std::vector<MarkingElement>& elements,
+                                   const std::vector<MarkingCandidate>& candidates,
+                                   const AssociationOptions& options);
+
+// A lane observation in the map frame, for association.
+struct LaneCandidate {
+  int class_id = 0;
+  std::vector<Eigen::Vector3d> points_map;  // ordered along the lane
+  // Per point: low enough IPM uncertainty to associate with (empty: all points are).
+  std::vector<bool> usable;
+  // Per point: x-y block of Omega_p in the map frame (empty: zero).
+  std::vector<Eigen::Matrix2d> cov_map;
+};
+
+// Cost of explaining `candidate` by `lane`: the median lateral distance in sigmas (the
+// point's lateral Omega_p plus lane_position_sigma_m^2); negative when the lane is not a
+// candidate (class, direction, support, or either gate fails: lane_gate_sigmas on that
+// median, lane_gate_m on the median in meters).
+double LaneAssociationCost(const LaneElement& lane, const LaneCandidate& candidate,
+                           const AssociationOptions& options);
+
+// For each candidate, the index of its lane element or -1 (new element).
+std::vector<int> AssociateLanes(const std::vector<LaneElement>& lanes,
+                                const std::vector<LaneCandidate>& candidates,
+                                const AssociationOptions& options);
+
+}  // namespace ipm_road_mapper

@@ -1,0 +1,57 @@
+// Instance extraction: 16UC1 instance mask -> marking rectangles and lane centerline points
+// on the ground of base_link (DESIGN.md §2 encoding, §4 markings).
+#pragma once
+
+#include <opencv2/core.hpp>
+#include <string>
+
+#include "ipm_road_mapper/core/frontend/class_table.h"
+#include "ipm_road_mapper/core/geometry/ipm.h"
+#include "ipm_road_mapper/core/geometry/ipm_uncertainty.h"
+#include "ipm_road_mapper/core/frontend/observations.h"
+#include "ipm_road_mapper/core/io/yaml_options.h"
+
+namespace ipm_road_mapper {
+
+// Tuning of the extraction (config section `extraction`).
+struct ExtractionOptions {
+  int min_marking_pixels = 150;        // smaller marking instances are dropped (tiny)
+  int min_lane_pixels = 80;            // smaller lane instances are dropped (tiny)
+  int border_margin_px = 2;            // markings with a pixel this close to the border: truncated
+  int lane_row_step = 4;               // take a lane centerline point every this many rows
+  int min_lane_points = 4;             // fewer valid centerline points: degenerate
+  int max_instances_per_frame = 300;   // beyond this, the remaining instances are dropped
+  double max_marking_range_m = 25.0;   // marking whose ground center is farther: dropped
+  double min_rectangle_side_m = 0.05;  // thinner ground rectangles are degenerate
+};
+
+// Reads the `extraction` section; throws OptionsError naming the bad key.
+ExtractionOptions LoadExtractionOptions(OptionsReader reader);
+
+// Checks a mask before extraction: CV_16UC1 and the camera's size. Empty when usable,
+// otherwise the reason (e.g. "mask is 640x480, camera is 1280x720").
+std::string ValidateMask(const cv::Mat& mask, int expected_width, int expected_height);
+
+// Sets the marking's rectangle from its outline with sides along `axis_base` (the road's
+// direction in base_link, x-y): corners on the ground in canonical order, their pixels, the
+// center and its Omega_p. The minimum-area rectangle is no substitute: for an arrow it can
+// lie along a slanted edge of the head, 0.3-0.4 m off at the corners and inconsistent from
+// frame to frame. False when a corner does not project.
+bool SetMarkingRectangle(const Ipm& ipm, const IpmErrorModel& error_model,
+                         const Eigen::Vector2d& axis_base, MarkingObservation* marking);
+
+// Extracts every instance of `mask` (which must pass ValidateMask; an unusable mask gives
+// nothing). One scan groups the pixels by value; unknown classes, tiny instances and markings
+// within border_margin_px of the border are dropped from its statistics; of the rest the
+// max_instances_per_frame largest are processed. Markings: sub-pixel outline of the
+// significant 8-connected pieces (every glyph of a text; specks under a tenth of the largest
+// piece are left out) -> IPM (any outline point failing: dropped_range) -> the rectangle
+// along base_link's x axis (SetMarkingRectangle) -> canonical corners, projected back for
+// the pixel measurements.
+// Lanes: every lane_row_step rows from the bottom, the center column of each run of the
+// instance's pixels in that row -> IPM point + uncertainty score. Results sorted by value.
+FrameObservations ExtractObservations(const cv::Mat& mask, const ClassTable& classes,
+                                      const Ipm& ipm, const IpmErrorModel& error_model,
+                                      const ExtractionOptions& options);
+
+}  // namespace ipm_road_mapper

@@ -1,0 +1,87 @@
+// The mapper's working map: elements with their observation histories (what the back end
+// optimizes over) and the frames that observed them. VectorMap (vector_map.h) is the
+// exported view of it.
+#pragma once
+
+#include <Eigen/Geometry>
+#include <array>
+#include <cstddef>
+#include <cstdint>
+#include <vector>
+
+#include "ipm_road_mapper/core/frontend/observations.h"
+
+namespace ipm_road_mapper {
+
+// One frame the mapper used: its odometry pose and its current (corrected) pose.
+struct FrameRecord {
+  std::size_t index = 0;  // position in RoadMap::frames
+  double stamp = 0.0;
+  Eigen::Isometry3d T_map_base_odom = Eigen::Isometry3d::Identity();
+  Eigen::Isometry3d T_map_base = Eigen::Isometry3d::Identity();  // corrected estimate
+};
+
+// One observation of a marking, corners already in the element's corner order.
+struct MarkingMeasurement {
+  std::size_t frame_index = 0;
+  std::array<Eigen::Vector2d, 4> corners_uv;    // pixel measurements z_k (flat-ground IPM)
+  std::array<Eigen::Vector3d, 4> corners_base;  // their IPM ground points at observation time
+  // The instance's convex outline in the image: the back end re-measures the corners from
+  // it on a better road plane than base_link's (MeasureCornersOnPlane).
+  std::vector<Eigen::Vector2d> outline_uv;
+};
+
+// A mapped ground marking.
+struct MarkingElement {
+  std::uint64_t id = 0;
+  int class_id = 0;
+  std::array<Eigen::Vector3d, 4> corners_map;  // current estimate
+  // x-y covariance of the estimate for association: Omega_p of the best observation (the
+  // plain-IPM errors of one element's observations are correlated, so no 1/n).
+  Eigen::Matrix2d center_cov_map = Eigen::Matrix2d::Zero();
+  std::vector<MarkingMeasurement> history;
+  std::size_t first_frame = 0, last_frame = 0;
+  double first_seen = 0.0, last_seen = 0.0;
+  bool optimized = false;  // the back end owns the estimate from now on
+  bool retired = false;    // left the window: its information is in the extrinsic prior
+  Eigen::Vector3d Center() const {
+    return 0.25 * (corners_map[0] + corners_map[1] + corners_map[2] + corners_map[3]);
+  }
+};
+
+// One observation of a lane: its centerline points (pixels, ground, scores) and which of
+// them point selection kept.
+struct LaneMeasurement {
+  std::size_t frame_index = 0;
+  std::vector<LanePoint> points;
+  std::vector<std::uint8_t> selected;  // 1 where PS kept the point (all 1 without PS)
+  // The selected points in the map frame, with the pose and extrinsic of observation time
+  // (what the growth of the lane's ends fits).
+  std::vector<Eigen::Vector3d> selected_map;
+};
+
+// A mapped lane line.
+struct LaneElement {
+  std::uint64_t id = 0;
+  int class_id = 0;
+  std::vector<Eigen::Vector3d> control_points_map;  // Catmull-Rom, phantom ends included
+  // Global index of control_points_map[0]; decreases as the lane grows at its start, so
+  // back-end results computed on an older copy can be applied point by point.
+  std::int64_t first_cp_index = 0;
+  std::vector<LaneMeasurement> history;
+  std::size_t first_frame = 0, last_frame = 0;
+  double first_seen = 0.0, last_seen = 0.0;
+  bool optimized = false;  // control points refined by a lane residual
+  // Observations of frames before this one no longer enter windows.
+  std::size_t retired_before_frame = 0;
+};
+
+// Elements and frames.
+struct RoadMap {
+  std::vector<FrameRecord> frames;
+  std::vector<MarkingElement> markings;
+  std::vector<LaneElement> lanes;
+  std::uint64_t next_id = 1;
+};
+
+}  // namespace ipm_road_mapper

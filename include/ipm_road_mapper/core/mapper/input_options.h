@@ -1,0 +1,30 @@
+// Where the mapper's input comes from (config section `input`): topic names, frames, the
+// sync policy and an optional extrinsic that overrides tf / the bag's /tf_static. Read by
+// both the offline runner and the nodelet, so the two agree.
+#pragma once
+
+#include <Eigen/Geometry>
+#include <optional>
+#include <string>
+
+#include "ipm_road_mapper/core/io/yaml_options.h"
+
+namespace ipm_road_mapper {
+
+struct InputOptions {
+  std::string mask_topic = "/camera/instances";
+  std::string camera_info_topic = "/camera/camera_info";
+  std::string image_topic = "/camera/image_raw";  // optional, debug overlay only
+  std::string odom_topic = "/odom";
+  std::string base_frame = "base_link";
+  std::string sync = "exact";  // exact or approximate (mask <-> camera_info)
+  // Rough extrinsic T_base_cam given in the config (xyz m, rpy deg of the optical frame in
+  // base_link); when absent it comes from tf (/tf_static in a bag).
+  std::optional<Eigen::Isometry3d> T_base_cam;
+};
+
+// Reads the `input` section (extrinsic as {xyz: [x,y,z], rpy_deg: [r,p,y]}); throws
+// OptionsError naming the bad key.
+InputOptions LoadInputOptions(OptionsReader reader);
+
+}  // namespace ipm_road_mapper

@@ -1,0 +1,102 @@
+#include "ipm_road_mapper/core/backend/backend_options.h"
+
+#include <cmath>
+#include <vector>
+
+namespace ipm_road_mapper {
+
+const char* ToString(LaneResidual residual) {
+  switch (residual) {
+    case LaneResidual::kPsr:
+      return "psr";
+    case LaneResidual::kPpsr:
+      return "ppsr";
+    default:
+      return "none";
+  }
+}
+
+namespace {
+
+constexpr double kDegToRad = M_PI / 180.0;
+
+std::string CheckPositiveTriple(const std::vector<double>& v) {
+  if (v.size() != 3) return "must have 3 values";
+  for (double x : v) {
+    if (!std::isfinite(x) || x <= 0.0) return "values must be finite and > 0";
+  }
+  return "";
+}
+
+Eigen::Vector3d ReadTriple(OptionsReader* reader, const std::string& key,
+                           const Eigen::Vector3d& default_value, double scale) {
+  std::vector<double> v{default_value.x() / scale, default_value.y() / scale,
+                        default_value.z() / scale};
+  reader->Read<std::vector<double>>(key, &v, CheckPositiveTriple);
+  return Eigen::Vector3d(v[0], v[1], v[2]) * scale;
+}
+
+}  // namespace
+
+BackendOptions LoadBackendOptions(OptionsReader reader) {
+  BackendOptions o;
+  reader.Read<bool>("enabled", &o.enabled);
+  reader.Read<bool>("synchronous", &o.synchronous);
+  reader.Read<bool>("optimize_extrinsic", &o.optimize_extrinsic);
+  reader.Read<bool>("optimize_markings", &o.optimize_markings);
+  reader.Read<bool>("optimize_z", &o.optimize_z);
+  reader.Read<bool>("pose_update", &o.pose_update);
+  std::string lane_residual = ToString(o.lane_residual);
+  reader.Read<std::string>("lane_residual", &lane_residual, [](const std::string& v) {
+    return v == "none" || v == "psr" || v == "ppsr" ? "" : "must be none, psr or ppsr";
+  });
+  o.lane_residual = lane_residual == "ppsr"  ? LaneResidual::kPpsr
+                    : lane_residual == "psr" ? LaneResidual::kPsr
+                                             : LaneResidual::kNone;
+  reader.Read<int>("window_frames", &o.window_frames, CheckPositiveInt);
+  reader.Read<int>("solve_every_n_frames", &o.solve_every_n_frames, CheckPositiveInt);
+  reader.Read<int>("rounds", &o.rounds, CheckPositiveInt);
+  reader.Read<int>("max_iterations", &o.max_iterations, CheckPositiveInt);
+  reader.Read<int>("queue_size", &o.queue_size, CheckPositiveInt);
+  reader.Read<double>("pixel_sigma_px", &o.pixel_sigma_px, CheckPositive);
+  reader.Read<double>("psr_sigma_m", &o.psr_sigma_m, CheckPositive);
+  reader.Read<std::string>("robust_kernel", &o.robust_kernel, [](const std::string& v) {
+    return v == "huber" || v == "cauchy" || v == "none" ? "" : "must be huber, cauchy or none";
+  });
+  reader.Read<double>("robust_scale", &o.robust_scale, CheckPositive);
+  o.translation_prior_sigma_m =
+      ReadTriple(&reader, "translation_prior_sigma_m", o.translation_prior_sigma_m, 1.0);
+  o.rotation_prior_sigma_rad =
+      ReadTriple(&reader, "rotation_prior_sigma_deg", o.rotation_prior_sigma_rad, kDegToRad);
+  o.pose_prior_sigma_trans_m =
+      ReadTriple(&reader, "pose_prior_sigma_trans_m", o.pose_prior_sigma_trans_m, 1.0);
+  o.pose_prior_sigma_rot_rad =
+      ReadTriple(&reader, "pose_prior_sigma_rot_deg", o.pose_prior_sigma_rot_rad, kDegToRad);
+  double max_change_deg = o.max_extrinsic_change_rad / kDegToRad;
+  reader.Read<double>("max_extrinsic_change_deg", &max_change_deg, CheckPositive);
+  o.max_extrinsic_change_rad = max_change_deg * kDegToRad;
+  reader.Read<double>("max_extrinsic_change_m", &o.max_extrinsic_change_m, CheckPositive);
+  reader.Read<int>("max_lane_points_per_observation", &o.max_lane_points_per_observation,
+                   CheckPositiveInt);
+  reader.Read<int>("max_measurements_per_marking", &o.max_measurements_per_marking,
+                   [](const int& v) { return v >= 2 ? "" : "must be >= 2"; });
+  reader.Read<double>("road_height_sigma_m", &o.road_height_sigma_m, CheckPositive);
+  reader.Read<double>("road_height_sigma_per_m", &o.road_height_sigma_per_m, CheckNonNegative);
+  reader.Read<double>("road_plane_radius_m", &o.road_plane_radius_m, CheckNonNegative);
+  reader.Read<double>("lane_anchor_along_sigma_m", &o.lane_anchor_along_sigma_m, CheckPositive);
+  reader.Read<double>("lane_anchor_across_sigma_m", &o.lane_anchor_across_sigma_m, CheckPositive);
+  reader.Read<double>("lane_smoothness_sigma_m", &o.lane_smoothness_sigma_m, CheckNonNegative);
+  reader.Read<bool>("motion_prior", &o.motion_prior);
+  o.motion_sigma_acc_mps2 =
+      ReadTriple(&reader, "motion_sigma_acc_mps2", o.motion_sigma_acc_mps2, 1.0);
+  o.motion_sigma_angular_acc_radps2 = ReadTriple(&reader, "motion_sigma_angular_acc_radps2",
+                                                 o.motion_sigma_angular_acc_radps2, 1.0);
+  reader.Read<bool>("final_global_solve", &o.final_global_solve);
+  reader.Read<double>("map_step_pose_sigma_scale", &o.map_step_pose_sigma_scale, CheckNonNegative);
+  reader.Read<int>("final_global_max_frames", &o.final_global_max_frames, CheckPositiveInt);
+  reader.Read<int>("final_global_rounds", &o.final_global_rounds, CheckPositiveInt);
+  reader.RejectUnknownKeys();
+  return o;
+}
+
+}  // namespace ipm_road_mapper

@@ -1,0 +1,186 @@
+#include "ipm_road_mapper/core/frontend/association.h"
+
+#include <algorithm>
+#include <cmath>
+#include <limits>
+#include <tuple>
+
+#include "ipm_road_mapper/core/geometry/catmull_rom_spline.h"
+
+namespace ipm_road_mapper {
+
+AssociationOptions LoadAssociationOptions(OptionsReader reader) {
+  AssociationOptions o;
+  reader.Read<double>("marking_gate_sigmas", &o.marking_gate_sigmas, CheckPositive);
+  reader.Read<double>("marking_position_sigma_m", &o.marking_position_sigma_m, CheckPositive);
+  reader.Read<double>("marking_merge_distance_m", &o.marking_merge_distance_m, CheckNonNegative);
+  reader.Read<double>("marking_merge_overlap", &o.marking_merge_overlap, CheckProbability);
+  reader.Read<double>("lane_max_point_score_m2", &o.lane_max_point_score_m2, CheckPositive);
+  reader.Read<double>("lane_gate_m", &o.lane_gate_m, CheckPositive);
+  reader.Read<double>("lane_gate_sigmas", &o.lane_gate_sigmas, CheckPositive);
+  reader.Read<double>("lane_position_sigma_m", &o.lane_position_sigma_m, CheckPositive);
+  reader.Read<double>("lane_min_direction_cos", &o.lane_min_direction_cos, CheckProbability);
+  reader.Read<double>("lane_max_end_gap_m", &o.lane_max_end_gap_m, CheckNonNegative);
+  reader.Read<double>("lane_min_support", &o.lane_min_support, CheckProbability);
+  reader.Read<int>("spurious_after_frames", &o.spurious_after_frames, CheckPositiveInt);
+  reader.RejectUnknownKeys();
+  return o;
+}
+
+int BestCyclicShift(const std::array<Eigen::Vector3d, 4>& element,
+                    const std::array<Eigen::Vector3d, 4>& observation, double* mean_distance_m) {
+  int best_shift = 0;
+  double best_sum = std::numeric_limits<double>::infinity();
+  for (int shift = 0; shift < 4; ++shift) {
+    double sum = 0.0;
+    for (int i = 0; i < 4; ++i) sum += (element[i] - observation[(i + shift) % 4]).norm();
+    if (sum < best_sum) {
+      best_sum = sum;
+      best_shift = shift;
+    }
+  }
+  if (mean_distance_m) *mean_distance_m = best_sum / 4.0;
+  return best_shift;
+}
+
+namespace {
+
+// Greedy one-to-one assignment over (cost, candidate, element) triples.
+std::vector<int> AssignGreedy(std::vector<std::tuple<double, int, int>> pairs, int num_candidates,
+                              int num_elements) {
+  std::sort(pairs.begin(), pairs.end());
+  std::vector<int> assignment(num_candidates, -1);
+  std::vector<bool> element_taken(num_elements, false);
+  for (const auto& [cost, candidate, element] : pairs) {
+    if (assignment[candidate] >= 0 || element_taken[element]) continue;
+    assignment[candidate] = element;
+    element_taken[element] = true;
+  }
+  return assignment;
+}
+
+Eigen::Vector3d Mean(const std::array<Eigen::Vector3d, 4>& corners) {
+  return 0.25 * (corners[0] + corners[1] + corners[2] + corners[3]);
+}
+
+}  // namespace
+
+double MarkingFloorSigma(const AssociationOptions& options) {
+  return std::hypot(options.marking_position_sigma_m, options.odometry_sigma_m);
+}
+
+double LaneFloorSigma(const AssociationOptions& options) {
+  return std::hypot(options.lane_position_sigma_m, options.odometry_sigma_m);
+}
+
+double MarkingAssociationCost(const MarkingElement& element, const MarkingCandidate& candidate,
+                              const AssociationOptions& options) {
+  // Compare in x-y: the mapped z of a marking is refined later, the gate is planar.
+  const Eigen::Vector2d d = (element.Center() - Mean(candidate.corners_map)).head<2>();
+  const double floor = std::pow(MarkingFloorSigma(options), 2);
+  const Eigen::Matrix2d S =
+      candidate.center_cov_map + element.center_cov_map + floor * Eigen::Matrix2d::Identity();
+  return d.dot(S.ldlt().solve(d));
+}
+
+std::vector<int> AssociateMarkings(const std::vector<MarkingElement>& elements,
+                                   const std::vector<MarkingCandidate>& candidates,
+                                   const AssociationOptions& options) {
+  std::vector<std::tuple<double, int, int>> pairs;
+  const double gate = options.marking_gate_sigmas * options.marking_gate_sigmas;
+  for (int c = 0; c < static_cast<int>(candidates.size()); ++c) {
+    for (int e = 0; e < static_cast<int>(elements.size()); ++e) {
+      if (elements[e].class_id != candidates[c].class_id) continue;
+      const double cost = MarkingAssociationCost(elements[e], candidates[c], options);
+      if (cost <= gate) pairs.emplace_back(cost, c, e);
+    }
+  }
+  return AssignGreedy(std::move(pairs), static_cast<int>(candidates.size()),
+                      static_cast<int>(elements.size()));
+}
+
+double LaneAssociationCost(const LaneElement& lane, const LaneCandidate& candidate,
+                           const AssociationOptions& options) {
+  if (lane.class_id != candidate.class_id || lane.control_points_map.size() < 4 ||
+      candidate.points_map.size() < 2) {
+    return -1.0;
+  }
+  std::vector<Eigen::Vector3d> points;
+  std::vector<Eigen::Matrix2d> covs;
+  for (std::size_t i = 0; i < candidate.points_map.size(); ++i) {
+    if (!candidate.usable.empty() && !candidate.usable[i]) continue;
+    points.push_back(candidate.points_map[i]);
+    covs.push_back(candidate.cov_map.empty() ? Eigen::Matrix2d::Zero() : candidate.cov_map[i]);
+  }
+  if (points.size() < 2) return -1.0;
+  const double floor = std::pow(LaneFloorSigma(options), 2);
+  const double gate_m =
+      std::max(options.lane_gate_m, options.lane_gate_sigmas * LaneFloorSigma(options));
+  // Only the part of the lane near the observation (a lane can be kilometers long); the
+  // margin covers points past an end that still count.
+  std::size_t first = 0, last = 0;
+  if (!ControlPointRangeNear(lane.control_points_map, points, options.lane_max_end_gap_m + 5.0,
+                             &first, &last)) {
+    return -1.0;
+  }
+  const CatmullRomSpline spline(std::vector<Eigen::Vector3d>(
+      lane.control_points_map.begin() + first, lane.control_points_map.begin() + last + 1));
+  const bool has_start = first == 0, has_end = last + 1 == lane.control_points_map.size();
+  // Observation direction: from its first to its last point (ordered along the lane).
+  Eigen::Vector2d obs_dir = (points.back() - points.front()).head<2>();
+  if (obs_dir.norm() < 1e-6) return -1.0;
+  obs_dir.normalize();
+
+  // Use at most ~12 points spread over the observation: association runs every frame.
+  const std::size_t n = points.size();
+  const std::size_t step = std::max<std::size_t>(1, n / 12);
+  std::vector<double> lateral, normalized;
+  int used = 0, direction_votes = 0, direction_ok = 0;
+  const double end_s = spline.NumSegments();
+  for (std::size_t i = 0; i < n; i += step, ++used) {
+    const Eigen::Vector3d& p = points[i];
+    const CatmullRomSpline::ClosestPoint closest = spline.FindClosest(p);
+    Eigen::Vector2d tangent = spline.Derivative(closest.s).head<2>();
+    if (tangent.norm() < 1e-9) continue;
+    tangent.normalize();
+    const Eigen::Vector2d offset = (p - closest.point).head<2>();
+    const double along = offset.dot(tangent);
+    const bool at_end = (has_start && closest.s <= 1e-6) || (has_end && closest.s >= end_s - 1e-6);
+    if (at_end && std::abs(along) > options.lane_max_end_gap_m) continue;
+    // Past an end, the lateral distance is measured to the end tangent line.
+    const double lateral_m =
+        at_end ? std::abs(offset.x() * tangent.y() - offset.y() * tangent.x()) : offset.norm();
+    // The point's IPM variance across the lane (normal n of the tangent) plus the floor.
+    const Eigen::Vector2d normal(-tangent.y(), tangent.x());
+    const double variance = normal.dot(covs[i] * normal) + floor;
+    lateral.push_back(lateral_m);
+    normalized.push_back(lateral_m / std::sqrt(variance));
+    ++direction_votes;
+    if (std::abs(tangent.dot(obs_dir)) >= options.lane_min_direction_cos) ++direction_ok;
+  }
+  if (used == 0 || lateral.size() < std::max<std::size_t>(2, options.lane_min_support * used)) {
+    return -1.0;
+  }
+  if (direction_ok * 2 < direction_votes) return -1.0;
+  const std::size_t mid = lateral.size() / 2;
+  std::nth_element(lateral.begin(), lateral.begin() + mid, lateral.end());
+  std::nth_element(normalized.begin(), normalized.begin() + mid, normalized.end());
+  if (lateral[mid] > gate_m || normalized[mid] > options.lane_gate_sigmas) return -1.0;
+  return normalized[mid];
+}
+
+std::vector<int> AssociateLanes(const std::vector<LaneElement>& lanes,
+                                const std::vector<LaneCandidate>& candidates,
+                                const AssociationOptions& options) {
+  std::vector<std::tuple<double, int, int>> pairs;
+  for (int c = 0; c < static_cast<int>(candidates.size()); ++c) {
+    for (int e = 0; e < static_cast<int>(lanes.size()); ++e) {
+      const double cost = LaneAssociationCost(lanes[e], candidates[c], options);
+      if (cost >= 0.0) pairs.emplace_back(cost, c, e);
+    }
+  }
+  return AssignGreedy(std::move(pairs), static_cast<int>(candidates.size()),
+                      static_cast<int>(lanes.size()));
+}
+
+}  // namespace ipm_road_mapper

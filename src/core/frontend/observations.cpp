@@ -1,0 +1,15 @@
+#include "ipm_road_mapper/core/frontend/observations.h"
+
+namespace ipm_road_mapper {
+
+void ExtractionCounters::Add(const ExtractionCounters& o) {
+  instances_seen += o.instances_seen;
+  dropped_unknown_class += o.dropped_unknown_class;
+  dropped_tiny += o.dropped_tiny;
+  dropped_border += o.dropped_border;
+  dropped_range += o.dropped_range;
+  dropped_degenerate += o.dropped_degenerate;
+  dropped_instance_limit += o.dropped_instance_limit;
+}
+
+}  // namespace ipm_road_mapper

@@ -1,0 +1,181 @@
+#include "ipm_road_mapper/core/io/geojson_export.h"
+
+#include <GeographicLib/LocalCartesian.hpp>
+#include <algorithm>
+#include <array>
+#include <cmath>
+#include <stdexcept>
+#include <vector>
+
+#include "ipm_road_mapper/core/geometry/catmull_rom_spline.h"
+#include "json_io.h"
+
+namespace ipm_road_mapper {
+namespace {
+
+constexpr double kDegreeScale = 1e9;  // rounded to 1e-9 deg, ~0.1 mm on the Earth
+constexpr double kMetricScale = 1e4;  // rounded to 0.1 mm
+
+// Rounds to 1 / scale. Dividing the rounded integer by the power of ten gives the double
+// nearest to the decimal, so the JSON shows 18.0097 rather than 18.009700000000002.
+double Round(double value, double scale) { return std::round(value * scale) / scale + 0.0; }
+
+nlohmann::json Rounded(const Eigen::Vector3d& v, double scale) {
+  return nlohmann::json::array({Round(v.x(), scale), Round(v.y(), scale), Round(v.z(), scale)});
+}
+constexpr int kGeoJsonIndent = 1;
+
+// Map-frame points -> GeoJSON positions, local or geographic.
+class PositionConverter {
+ public:
+  explicit PositionConverter(const std::optional<GeoOrigin>& origin) {
+    if (origin) {
+      local_cartesian_.emplace(origin->latitude_deg, origin->longitude_deg, origin->altitude_m);
+    }
+  }
+
+  // [lon, lat, alt] with an origin (x = east, y = north, z = up), else [x, y, z].
+  nlohmann::json Position(const Eigen::Vector3d& p_map) const {
+    if (!local_cartesian_) return Rounded(p_map, kMetricScale);
+    double latitude_deg = 0.0, longitude_deg = 0.0, altitude_m = 0.0;
+    local_cartesian_->Reverse(p_map.x(), p_map.y(), p_map.z(), latitude_deg, longitude_deg,
+                              altitude_m);
+    return nlohmann::json::array({Round(longitude_deg, kDegreeScale),
+                                  Round(latitude_deg, kDegreeScale),
+                                  Round(altitude_m, kMetricScale)});
+  }
+
+  const char* CoordinateSystem() const {
+    return local_cartesian_ ? kCoordinateSystemWgs84 : kCoordinateSystemLocal;
+  }
+
+ private:
+  std::optional<GeographicLib::LocalCartesian> local_cartesian_;
+};
+
+// Twice the signed area of the polygon's x-y projection (> 0: counter-clockwise from above).
+double SignedArea2(const std::array<Eigen::Vector3d, 4>& corners) {
+  double area2 = 0.0;
+  for (std::size_t i = 0; i < corners.size(); ++i) {
+    const Eigen::Vector3d& a = corners[i];
+    const Eigen::Vector3d& b = corners[(i + 1) % corners.size()];
+    area2 += a.x() * b.y() - b.x() * a.y();
+  }
+  return area2;
+}
+
+nlohmann::json MarkingFeature(const MapMarking& marking, const PositionConverter& converter) {
+  // East/north map axes keep their orientation in lon/lat, so a ring that is
+  // counter-clockwise in the map frame is counter-clockwise in the output too.
+  std::vector<Eigen::Vector3d> ring(marking.corners_map.begin(), marking.corners_map.end());
+  if (SignedArea2(marking.corners_map) < 0.0) std::reverse(ring.begin() + 1, ring.end());
+  ring.push_back(ring.front());
+  nlohmann::json positions = nlohmann::json::array();
+  for (const Eigen::Vector3d& p_map : ring) positions.push_back(converter.Position(p_map));
+
+  nlohmann::json properties = {{"id", marking.id},
+                               {"class_name", marking.class_name},
+                               {"class_id", marking.class_id},
+                               {"kind", "marking"},
+                               {"style", nullptr},
+                               {"observations", marking.observations},
+                               {"first_seen", marking.first_seen},
+                               {"last_seen", marking.last_seen},
+                               {"coordinate_system", converter.CoordinateSystem()}};
+  return {{"type", "Feature"},
+          {"id", marking.id},
+          {"geometry", {{"type", "Polygon"}, {"coordinates", nlohmann::json::array({positions})}}},
+          {"properties", properties}};
+}
+
+// Points of the lane's LineString (see the header for the fallbacks).
+std::vector<Eigen::Vector3d> LanePolyline(const MapLane& lane) {
+  if (lane.control_points_map.size() >= 4) {
+    try {
+      return CatmullRomSpline(lane.control_points_map).SampleByArcLength(kLaneSampleSpacing_m);
+    } catch (const std::invalid_argument&) {
+      return {};  // a non-finite control point: no geometry rather than a broken one
+    }
+  }
+  if (lane.control_points_map.size() >= 2) return lane.control_points_map;
+  return {};
+}
+
+nlohmann::json LaneFeature(const MapLane& lane, const PositionConverter& converter) {
+  nlohmann::json control_points = nlohmann::json::array();
+  for (const Eigen::Vector3d& c_map : lane.control_points_map) {
+    control_points.push_back(Rounded(c_map, kMetricScale));
+  }
+  nlohmann::json geometry = nullptr;
+  const std::vector<Eigen::Vector3d> polyline = LanePolyline(lane);
+  if (polyline.size() >= 2) {
+    nlohmann::json positions = nlohmann::json::array();
+    for (const Eigen::Vector3d& p_map : polyline) positions.push_back(converter.Position(p_map));
+    geometry = {{"type", "LineString"}, {"coordinates", positions}};
+  }
+  nlohmann::json properties = {
+      {"id", lane.id},
+      {"class_name", lane.class_name},
+      {"class_id", lane.class_id},
+      {"kind", "lane"},
+      {"style", lane.style.empty() ? nlohmann::json(nullptr) : nlohmann::json(lane.style)},
+      {"observations", lane.observations},
+      {"first_seen", lane.first_seen},
+      {"last_seen", lane.last_seen},
+      {"control_points", control_points},
+      {"coordinate_system", converter.CoordinateSystem()}};
+  return {{"type", "Feature"}, {"id", lane.id}, {"geometry", geometry}, {"properties", properties}};
+}
+
+}  // namespace
+
+nlohmann::json VectorMapToGeoJson(const VectorMap& map, const std::optional<GeoOrigin>& origin) {
+  const PositionConverter converter(origin);
+  nlohmann::json features = nlohmann::json::array();
+  for (const MapMarking& marking : map.markings) {
+    features.push_back(MarkingFeature(marking, converter));
+  }
+  for (const MapLane& lane : map.lanes) features.push_back(LaneFeature(lane, converter));
+  // Foreign members (allowed by RFC 7946 §6.1): how to read the positions.
+  nlohmann::json collection = {{"type", "FeatureCollection"},
+                               {"coordinate_system", converter.CoordinateSystem()},
+                               {"frame_id", map.frame_id}};
+  if (origin) {
+    collection["geo_origin"] = {{"latitude_deg", origin->latitude_deg},
+                                {"longitude_deg", origin->longitude_deg},
+                                {"altitude_m", origin->altitude_m}};
+  }
+  collection["features"] = std::move(features);
+  return collection;
+}
+
+void SaveGeoJson(const VectorMap& map, const std::optional<GeoOrigin>& origin,
+                 const std::string& path) {
+  json_io::WriteFileAtomically(path, VectorMapToGeoJson(map, origin).dump(kGeoJsonIndent) + "\n");
+}
+
+std::optional<GeoOrigin> LoadGeoOrigin(OptionsReader reader) {
+  const bool any_key =
+      reader.Has("latitude_deg") || reader.Has("longitude_deg") || reader.Has("altitude_m");
+  auto in_range = [](double limit) {
+    return [limit](const double& v) -> std::string {
+      return std::isfinite(v) && std::abs(v) <= limit
+                 ? ""
+                 : "must be in [-" + std::to_string(static_cast<int>(limit)) + ", " +
+                       std::to_string(static_cast<int>(limit)) + "]";
+    };
+  };
+  GeoOrigin origin;
+  if (any_key) {
+    reader.ReadRequired<double>("latitude_deg", &origin.latitude_deg, in_range(90.0));
+    reader.ReadRequired<double>("longitude_deg", &origin.longitude_deg, in_range(180.0));
+  }
+  reader.Read<double>("altitude_m", &origin.altitude_m, [](const double& v) -> std::string {
+    return std::isfinite(v) ? "" : "must be finite";
+  });
+  reader.RejectUnknownKeys();
+  if (!any_key) return std::nullopt;
+  return origin;
+}
+
+}  // namespace ipm_road_mapper

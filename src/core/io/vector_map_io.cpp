@@ -1,0 +1,198 @@
+// Map JSON reading and writing (format: docs/file_formats.md).
+#include <iomanip>
+#include <set>
+#include <sstream>
+#include <stdexcept>
+
+#include "ipm_road_mapper/core/map/vector_map.h"
+#include "json_io.h"
+
+namespace ipm_road_mapper {
+namespace {
+
+using json_io::Fail;
+using json_io::Index;
+using json_io::Key;
+using json_io::Member;
+
+constexpr char kMapFormat[] = "ipm_road_mapper/vector_map";
+// Indentation of the saved file: one level per nesting, small but still diff-able.
+constexpr int kMapIndent = 1;
+
+nlohmann::json MarkingToJson(const MapMarking& m) {
+  nlohmann::json corners = nlohmann::json::array();
+  for (const Eigen::Vector3d& c : m.corners_map) corners.push_back(json_io::Vector3ToJson(c));
+  return {{"id", m.id},
+          {"class_id", m.class_id},
+          {"class_name", m.class_name},
+          {"corners", corners},
+          {"observations", m.observations},
+          {"first_seen", m.first_seen},
+          {"last_seen", m.last_seen}};
+}
+
+nlohmann::json LaneToJson(const MapLane& lane) {
+  nlohmann::json points = nlohmann::json::array();
+  for (const Eigen::Vector3d& c : lane.control_points_map) {
+    points.push_back(json_io::Vector3ToJson(c));
+  }
+  return {{"id", lane.id},
+          {"class_id", lane.class_id},
+          {"class_name", lane.class_name},
+          {"style", lane.style},
+          {"control_points", points},
+          {"observations", lane.observations},
+          {"first_seen", lane.first_seen},
+          {"last_seen", lane.last_seen}};
+}
+
+MapMarking MarkingFromJson(const nlohmann::json& j, const std::string& where) {
+  MapMarking m;
+  m.id = json_io::ReadUint64(Member(j, "id", where), Key(where, "id"));
+  m.class_id = json_io::ReadInt(Member(j, "class_id", where), Key(where, "class_id"));
+  m.class_name = json_io::OptionalString(j, "class_name", "", where);
+  const std::string corners_where = Key(where, "corners");
+  const nlohmann::json& corners = json_io::ReadArray(Member(j, "corners", where), corners_where);
+  if (corners.size() != 4) {
+    Fail(corners_where, "expected 4 corners, got " + std::to_string(corners.size()));
+  }
+  for (std::size_t k = 0; k < 4; ++k) {
+    m.corners_map[k] = json_io::ReadVector3(corners[k], Index(corners_where, k));
+  }
+  m.observations = json_io::OptionalInt(j, "observations", 0, where);
+  m.first_seen = json_io::OptionalNumber(j, "first_seen", 0.0, where);
+  m.last_seen = json_io::OptionalNumber(j, "last_seen", 0.0, where);
+  return m;
+}
+
+MapLane LaneFromJson(const nlohmann::json& j, const std::string& where) {
+  MapLane lane;
+  lane.id = json_io::ReadUint64(Member(j, "id", where), Key(where, "id"));
+  lane.class_id = json_io::ReadInt(Member(j, "class_id", where), Key(where, "class_id"));
+  lane.class_name = json_io::OptionalString(j, "class_name", "", where);
+  lane.style = json_io::OptionalString(j, "style", "", where);
+  const std::string points_where = Key(where, "control_points");
+  const nlohmann::json& points =
+      json_io::ReadArray(Member(j, "control_points", where), points_where);
+  if (points.size() < 4) {
+    Fail(points_where, "a lane needs at least 4 control points (2 of them phantom ends), got " +
+                           std::to_string(points.size()));
+  }
+  for (std::size_t k = 0; k < points.size(); ++k) {
+    lane.control_points_map.push_back(json_io::ReadVector3(points[k], Index(points_where, k)));
+  }
+  lane.observations = json_io::OptionalInt(j, "observations", 0, where);
+  lane.first_seen = json_io::OptionalNumber(j, "first_seen", 0.0, where);
+  lane.last_seen = json_io::OptionalNumber(j, "last_seen", 0.0, where);
+  return lane;
+}
+
+}  // namespace
+
+nlohmann::json PoseToJson(const Eigen::Isometry3d& T) {
+  Eigen::Quaterniond q(T.linear());
+  if (q.w() < 0.0) q.coeffs() = -q.coeffs();  // canonical sign: same rotation, stable bytes
+  return {{"t", json_io::Vector3ToJson(T.translation())}, {"q_xyzw", {q.x(), q.y(), q.z(), q.w()}}};
+}
+
+Eigen::Isometry3d PoseFromJson(const nlohmann::json& j) { return json_io::ReadPose(j, ""); }
+
+nlohmann::json VectorMapToJson(const VectorMap& map) {
+  nlohmann::json markings = nlohmann::json::array();
+  for (const MapMarking& m : map.markings) markings.push_back(MarkingToJson(m));
+  nlohmann::json lanes = nlohmann::json::array();
+  for (const MapLane& lane : map.lanes) lanes.push_back(LaneToJson(lane));
+  nlohmann::json trajectory = nlohmann::json::array();
+  for (const StampedPose& pose : map.trajectory) {
+    nlohmann::json entry = PoseToJson(pose.T_map_base);
+    entry["stamp"] = pose.stamp;
+    trajectory.push_back(std::move(entry));
+  }
+  return {{"format", kMapFormat},
+          {"version", kVectorMapFormatVersion},
+          {"frame_id", map.frame_id},
+          {"T_base_cam", PoseToJson(map.T_base_cam)},
+          {"T_base_cam_initial", PoseToJson(map.T_base_cam_initial)},
+          {"markings", markings},
+          {"lanes", lanes},
+          {"trajectory", trajectory},
+          {"metadata", map.metadata}};
+}
+
+VectorMap VectorMapFromJson(const nlohmann::json& j) {
+  json_io::CheckFormatHeader(j, kMapFormat, kVectorMapFormatVersion);
+  VectorMap map;
+  map.frame_id = json_io::OptionalString(j, "frame_id", "map", "");
+  map.T_base_cam = json_io::ReadPose(Member(j, "T_base_cam", ""), "T_base_cam");
+  map.T_base_cam_initial =
+      json_io::ReadPose(Member(j, "T_base_cam_initial", ""), "T_base_cam_initial");
+
+  std::set<std::uint64_t> marking_ids;
+  const nlohmann::json& markings = json_io::ReadArray(Member(j, "markings", ""), "markings");
+  for (std::size_t i = 0; i < markings.size(); ++i) {
+    map.markings.push_back(MarkingFromJson(markings[i], Index("markings", i)));
+    if (!marking_ids.insert(map.markings.back().id).second) {
+      Fail(Index("markings", i), "duplicate id " + std::to_string(map.markings.back().id));
+    }
+  }
+  std::set<std::uint64_t> lane_ids;
+  const nlohmann::json& lanes = json_io::ReadArray(Member(j, "lanes", ""), "lanes");
+  for (std::size_t i = 0; i < lanes.size(); ++i) {
+    map.lanes.push_back(LaneFromJson(lanes[i], Index("lanes", i)));
+    if (!lane_ids.insert(map.lanes.back().id).second) {
+      Fail(Index("lanes", i), "duplicate id " + std::to_string(map.lanes.back().id));
+    }
+  }
+  if (j.contains("trajectory")) {
+    const nlohmann::json& trajectory = json_io::ReadArray(j["trajectory"], "trajectory");
+    for (std::size_t i = 0; i < trajectory.size(); ++i) {
+      const std::string where = Index("trajectory", i);
+      StampedPose pose;
+      pose.stamp = json_io::ReadNumber(Member(trajectory[i], "stamp", where), Key(where, "stamp"));
+      pose.T_map_base = json_io::ReadPose(trajectory[i], where);
+      map.trajectory.push_back(pose);
+    }
+  }
+  if (j.contains("metadata")) {
+    if (!j["metadata"].is_object()) Fail("metadata", "expected an object");
+    map.metadata = j["metadata"];
+  }
+  return map;
+}
+
+void SaveVectorMapJson(const VectorMap& map, const std::string& path) {
+  const nlohmann::json j = VectorMapToJson(map);
+  // Refuse what the reader would reject (NaN, too few control points, duplicate ids), so a
+  // saved map always loads again.
+  try {
+    VectorMapFromJson(j);
+  } catch (const MapFormatError& e) {
+    throw std::runtime_error(path + ": cannot save map: " + e.what());
+  }
+  json_io::WriteFileAtomically(path, j.dump(kMapIndent) + "\n");
+}
+
+VectorMap LoadVectorMapJson(const std::string& path) {
+  const nlohmann::json j = json_io::ParseJsonFile(path);
+  try {
+    return VectorMapFromJson(j);
+  } catch (const MapFormatError& e) {
+    throw MapFormatError(path + ": " + e.what());
+  }
+}
+
+void WriteTumTrajectory(const std::vector<StampedPose>& poses, const std::string& path) {
+  std::ostringstream out;
+  out << std::fixed;
+  for (const StampedPose& pose : poses) {
+    Eigen::Quaterniond q(pose.T_map_base.linear());
+    if (q.w() < 0.0) q.coeffs() = -q.coeffs();
+    const Eigen::Vector3d& t = pose.T_map_base.translation();
+    out << std::setprecision(9) << pose.stamp << std::setprecision(6) << ' ' << t.x() << ' '
+        << t.y() << ' ' << t.z() << std::setprecision(9) << ' ' << q.x() << ' ' << q.y() << ' '
+        << q.z() << ' ' << q.w() << '\n';
+  }
+  json_io::WriteFileAtomically(path, out.str());
+}
+
+}  // namespace ipm_road_mapper

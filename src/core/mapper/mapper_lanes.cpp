@@ -1,0 +1,203 @@
+// The lane half of the Mapper's front end: point selection, association, starting a lane
+// with g, growing its ends (FitLaneEnds), merging lanes that turn out to be one line, and the
+// re-fit of lanes that no lane residual refines.
+#include <algorithm>
+
+#include "ipm_road_mapper/core/frontend/association.h"
+#include "ipm_road_mapper/core/geometry/ipm.h"
+#include "ipm_road_mapper/core/geometry/lane_end_fit.h"
+#include "ipm_road_mapper/core/mapper/mapper.h"
+#include "ipm_road_mapper/core/geometry/spline_fitting.h"
+
+namespace ipm_road_mapper {
+namespace {
+
+// Point selection (PS): flags of the points kept for control-point estimation.
+std::vector<std::uint8_t> SelectPoints(const std::vector<LanePoint>& points,
+                                       const LaneOptions& options) {
+  std::vector<std::uint8_t> selected(points.size(), options.point_selection ? 0 : 1);
+  if (!options.point_selection) return selected;
+  std::vector<double> scores;
+  scores.reserve(points.size());
+  for (const LanePoint& p : points) {
+    scores.push_back(p.score <= options.max_selected_score_m2 ? p.score : std::nan(""));
+  }
+  for (std::size_t i : SelectLowestScores(scores, options.selected_points_per_frame)) {
+    selected[i] = 1;
+  }
+  return selected;
+}
+
+// Largest horizontal distance of a point from the first one.
+double Extent(const std::vector<Eigen::Vector3d>& points) {
+  double extent = 0.0;
+  for (std::size_t i = 1; i < points.size(); ++i) {
+    extent = std::max(extent, (points[i] - points.front()).head<2>().norm());
+  }
+  return extent;
+}
+
+}  // namespace
+
+void Mapper::AddLanes(const FrameObservations& observations, const FrameRecord& frame) {
+  std::vector<LaneCandidate> candidates;
+  std::vector<LaneMeasurement> measurements;
+  for (const LaneObservation& obs : observations.lanes) {
+    LaneCandidate candidate;
+    candidate.class_id = obs.class_id;
+    LaneMeasurement measurement;
+    measurement.frame_index = frame.index;
+    measurement.points = obs.points;
+    measurement.selected = SelectPoints(obs.points, options_.lanes);
+    const Eigen::Matrix2d R = frame.T_map_base.linear().topLeftCorner<2, 2>();
+    for (std::size_t i = 0; i < obs.points.size(); ++i) {
+      const Eigen::Vector3d p_map = frame.T_map_base * obs.points[i].p_base;
+      candidate.points_map.push_back(p_map);
+      candidate.cov_map.push_back(R * obs.points[i].cov_base * R.transpose());
+      candidate.usable.push_back(obs.points[i].score <=
+                                 options_.association.lane_max_point_score_m2);
+      if (measurement.selected[i]) measurement.selected_map.push_back(p_map);
+    }
+    candidates.push_back(std::move(candidate));
+    measurements.push_back(std::move(measurement));
+  }
+  const std::vector<int> match = AssociateLanes(map_.lanes, candidates, options_.association);
+  for (std::size_t c = 0; c < candidates.size(); ++c) {
+    if (match[c] < 0) {
+      // The start gate looks at every point of low enough uncertainty: the N best of PS
+      // alone may all lie on the nearest dash of a dashed line, shorter than the gate.
+      std::vector<Eigen::Vector3d> usable_map;
+      for (std::size_t i = 0; i < candidates[c].points_map.size(); ++i) {
+        if (candidates[c].usable[i]) usable_map.push_back(candidates[c].points_map[i]);
+      }
+      StartLane(candidates[c].class_id, measurements[c], usable_map, frame);
+      continue;
+    }
+    LaneElement& lane = map_.lanes[match[c]];
+    lane.history.push_back(std::move(measurements[c]));
+    lane.last_frame = frame.index;
+    lane.last_seen = frame.stamp;
+    std::vector<Eigen::Vector3d> usable_map;
+    for (std::size_t i = 0; i < candidates[c].points_map.size(); ++i) {
+      if (candidates[c].usable[i]) usable_map.push_back(candidates[c].points_map[i]);
+    }
+    GrowLane(&lane, frame.index, usable_map);
+  }
+  if (map_.frames.size() % static_cast<std::size_t>(options_.lanes.merge_every_n_frames) == 0) {
+    MergeLanes();
+  }
+}
+
+void Mapper::GrowLane(LaneElement* lane, std::size_t frame_index,
+                      const std::vector<Eigen::Vector3d>& usable_map) const {
+  const std::size_t horizon = static_cast<std::size_t>(options_.lanes.end_fit_frames);
+  std::vector<Eigen::Vector3d> points;
+  for (auto m = lane->history.rbegin(); m != lane->history.rend(); ++m) {
+    if (m->frame_index + horizon <= frame_index) break;
+    points.insert(points.end(), m->selected_map.begin(), m->selected_map.end());
+  }
+  int added_at_start = 0;
+  lane->control_points_map = FitLaneEnds(lane->control_points_map, points, options_.lanes.end_fit,
+                                         &added_at_start, &usable_map);
+  lane->first_cp_index -= added_at_start;  // keeps older back-end results applicable
+}
+
+void Mapper::StartLane(int class_id, const LaneMeasurement& measurement,
+                       const std::vector<Eigen::Vector3d>& usable_map, const FrameRecord& frame) {
+  if (Extent(usable_map) < options_.lanes.min_new_lane_length_m) {
+    ++counters_.lane_observations_unused;
+    return;
+  }
+  AssociationOptions loose = options_.association;
+  loose.lane_gate_m *= 2.0;
+  loose.lane_gate_sigmas *= 2.0;
+  LaneCandidate candidate{class_id, usable_map, {}, {}};
+  for (const LaneElement& lane : map_.lanes) {
+    if (LaneAssociationCost(lane, candidate, loose) >= 0.0) {
+      ++counters_.lane_observations_near_lane;
+      return;
+    }
+  }
+  auto control_points = EstimateControlPoints(measurement.selected_map, options_.lanes.fit);
+  if (!control_points) control_points = EstimateControlPoints(usable_map, options_.lanes.fit);
+  if (!control_points) {
+    ++counters_.lane_observations_unused;
+    return;
+  }
+  // Ordered along the direction of travel, so that the lane mostly grows at its end.
+  const Eigen::Vector3d heading = frame.T_map_base.linear().col(0);
+  if ((control_points->back() - control_points->front()).dot(heading) < 0.0) {
+    std::reverse(control_points->begin(), control_points->end());
+  }
+  LaneElement lane;
+  lane.id = map_.next_id++;
+  lane.class_id = class_id;
+  lane.control_points_map = std::move(*control_points);
+  lane.history.push_back(measurement);
+  lane.first_frame = lane.last_frame = frame.index;
+  lane.first_seen = lane.last_seen = frame.stamp;
+  map_.lanes.push_back(std::move(lane));
+  ++counters_.lanes_created;
+}
+
+std::vector<Eigen::Vector3d> Mapper::SelectedPointsMap(const LaneElement& lane) const {
+  const Ipm ipm(PinholeCamera(camera_), T_base_cam_, options_.ipm.max_range_m);
+  std::vector<Eigen::Vector3d> points;
+  for (const LaneMeasurement& m : lane.history) {
+    const Eigen::Isometry3d& T_map_base = map_.frames[m.frame_index].T_map_base;
+    for (std::size_t i = 0; i < m.points.size(); ++i) {
+      Eigen::Vector3d p_base;
+      if (m.selected[i] && ipm.PixelToGround(m.points[i].uv, &p_base) == IpmStatus::kOk) {
+        points.push_back(T_map_base * p_base);
+      }
+    }
+  }
+  return points;
+}
+
+std::vector<Eigen::Vector3d> Mapper::RefitControlPoints(const LaneElement& lane) const {
+  return FitLaneEnds(lane.control_points_map, SelectedPointsMap(lane), options_.lanes.end_fit);
+}
+
+void Mapper::MergeLanes() {
+  // Two lanes of one class that turn out to be one line (e.g. one was started while the
+  // other was not matched across a gap): the second's curve lies along the first.
+  for (std::size_t a = 0; a < map_.lanes.size(); ++a) {
+    for (std::size_t b = a + 1; b < map_.lanes.size();) {
+      LaneElement& first = map_.lanes[a];
+      LaneElement& second = map_.lanes[b];
+      LaneCandidate candidate;
+      candidate.class_id = second.class_id;
+      candidate.points_map = second.control_points_map;          // ordered along the lane
+      candidate.points_map.erase(candidate.points_map.begin());  // phantom ends out
+      candidate.points_map.pop_back();
+      if (candidate.points_map.size() < 2 ||
+          LaneAssociationCost(first, candidate, options_.association) < 0.0) {
+        ++b;
+        continue;
+      }
+      first.history.insert(first.history.end(), second.history.begin(), second.history.end());
+      std::sort(first.history.begin(), first.history.end(),
+                [](const LaneMeasurement& x, const LaneMeasurement& y) {
+                  return x.frame_index < y.frame_index;
+                });
+      first.first_frame = std::min(first.first_frame, second.first_frame);
+      first.last_frame = std::max(first.last_frame, second.last_frame);
+      first.first_seen = std::min(first.first_seen, second.first_seen);
+      first.last_seen = std::max(first.last_seen, second.last_seen);
+      // Grow `first` over the second's stretch; its own control points keep their indices.
+      std::vector<Eigen::Vector3d> points;
+      for (const LaneMeasurement& m : second.history) {
+        points.insert(points.end(), m.selected_map.begin(), m.selected_map.end());
+      }
+      int added_at_start = 0;
+      first.control_points_map =
+          FitLaneEnds(first.control_points_map, points, options_.lanes.end_fit, &added_at_start);
+      first.first_cp_index -= added_at_start;
+      map_.lanes.erase(map_.lanes.begin() + b);
+      ++counters_.lanes_merged;
+    }
+  }
+}
+
+}  // namespace ipm_road_mapper

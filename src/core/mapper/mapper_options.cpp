@@ -1,0 +1,115 @@
+#include "ipm_road_mapper/core/mapper/mapper_options.h"
+
+#include <cmath>
+#include <sstream>
+#include <vector>
+
+namespace ipm_road_mapper {
+namespace {
+constexpr double kDegToRad = M_PI / 180.0;
+}
+
+IpmOptions LoadIpmOptions(OptionsReader reader) {
+  IpmOptions o;
+  reader.Read<double>("max_range_m", &o.max_range_m, CheckPositive);
+  std::vector<double> pixel_error{o.error_model.pixel_error_px.x(),
+                                  o.error_model.pixel_error_px.y()};
+  reader.Read<std::vector<double>>("pixel_error_px", &pixel_error,
+                                   [](const std::vector<double>& v) -> std::string {
+                                     if (v.size() != 2) return "must be [du, dv]";
+                                     if (!std::isfinite(v[0]) || !std::isfinite(v[1])) {
+                                       return "must be finite";
+                                     }
+                                     return "";
+                                   });
+  o.error_model.pixel_error_px = {pixel_error[0], pixel_error[1]};
+  double pitch_sigma_deg = o.error_model.pitch_sigma_rad / kDegToRad;
+  reader.Read<double>("pitch_sigma_deg", &pitch_sigma_deg, CheckNonNegative);
+  o.error_model.pitch_sigma_rad = pitch_sigma_deg * kDegToRad;
+  reader.Read<double>("height_sigma_m", &o.error_model.height_sigma_m, CheckNonNegative);
+  reader.RejectUnknownKeys();
+  return o;
+}
+
+LaneOptions LoadLaneOptions(OptionsReader reader) {
+  LaneOptions o;
+  reader.Read<bool>("point_selection", &o.point_selection);
+  reader.Read<int>("selected_points_per_frame", &o.selected_points_per_frame, CheckPositiveInt);
+  reader.Read<double>("max_selected_score_m2", &o.max_selected_score_m2, CheckPositive);
+  reader.Read<double>("chord_spacing_m", &o.fit.chord_spacing_m, CheckPositive);
+  reader.Read<double>("smoothing_length_m", &o.fit.smoothing_length_m, CheckPositive);
+  o.end_fit.chord_spacing_m = o.fit.chord_spacing_m;
+  reader.Read<int>("end_fit_frames", &o.end_fit_frames, CheckPositiveInt);
+  reader.Read<int>("end_fit_min_points", &o.end_fit.min_points_to_extend, CheckPositiveInt);
+  reader.Read<double>("end_fit_max_point_distance_m", &o.end_fit.max_point_distance_m,
+                      CheckPositive);
+  reader.Read<double>("end_fit_smoothness", &o.end_fit.smoothness_weight, CheckNonNegative);
+  reader.Read<double>("end_fit_prior_sigma_m", &o.end_fit.prior_sigma_m, CheckPositive);
+  reader.Read<double>("end_fit_robust_scale_m", &o.end_fit.robust_scale_m, CheckPositive);
+  reader.Read<int>("merge_every_n_frames", &o.merge_every_n_frames, CheckPositiveInt);
+  reader.Read<double>("min_new_lane_length_m", &o.min_new_lane_length_m, CheckNonNegative);
+  reader.RejectUnknownKeys();
+  return o;
+}
+
+OdometryOptions LoadOdometryOptions(OptionsReader reader) {
+  OdometryOptions o;
+  reader.Read<double>("stamp_tolerance_s", &o.stamp_tolerance_s, CheckNonNegative);
+  reader.Read<double>("max_gap_s", &o.max_gap_s, CheckPositive);
+  reader.Read<int>("buffer_size", &o.buffer_size, CheckPositiveInt);
+  reader.RejectUnknownKeys();
+  return o;
+}
+
+MapperOptions LoadMapperOptions(OptionsReader reader) {
+  MapperOptions o;
+  reader.Read<std::string>("method", &o.method);
+  o.ipm = LoadIpmOptions(reader.Child("ipm"));
+  o.extraction = LoadExtractionOptions(reader.Child("extraction"));
+  o.association = LoadAssociationOptions(reader.Child("association"));
+  o.lanes = LoadLaneOptions(reader.Child("lanes"));
+  o.odometry = LoadOdometryOptions(reader.Child("odometry"));
+  o.input = LoadInputOptions(reader.Child("input"));
+  o.backend = LoadBackendOptions(reader.Child("backend"));
+  reader.RejectUnknownKeys();
+  return o;
+}
+
+MapperOptions LoadMapperOptionsFile(const std::string& path) {
+  try {
+    return LoadMapperOptions(OptionsReader::FromFile(path));
+  } catch (const OptionsError& e) {
+    const std::string what = e.what();
+    // FromFile already names the file; prefix it for errors found in the content.
+    throw OptionsError(what.rfind(path, 0) == 0 ? what : path + ": " + what);
+  }
+}
+
+AssociationOptions EffectiveAssociationOptions(const MapperOptions& options) {
+  AssociationOptions association = options.association;
+  association.odometry_sigma_m = options.backend.pose_prior_sigma_trans_m.head<2>().maxCoeff();
+  return association;
+}
+
+std::string ToString(const MapperOptions& o) {
+  std::ostringstream s;
+  s << "method: " << o.method << "\n"
+    << "ipm.max_range_m: " << o.ipm.max_range_m << "\n"
+    << "ipm.pixel_error_px: [" << o.ipm.error_model.pixel_error_px.x() << ", "
+    << o.ipm.error_model.pixel_error_px.y() << "]\n"
+    << "ipm.pitch_sigma_deg: " << o.ipm.error_model.pitch_sigma_rad / kDegToRad << "\n"
+    << "ipm.height_sigma_m: " << o.ipm.error_model.height_sigma_m << "\n"
+    << "lanes.point_selection: " << (o.lanes.point_selection ? "true" : "false") << "\n"
+    << "lanes.selected_points_per_frame: " << o.lanes.selected_points_per_frame << "\n"
+    << "lanes.chord_spacing_m: " << o.lanes.fit.chord_spacing_m << "\n"
+    << "association.marking_gate_sigmas: " << o.association.marking_gate_sigmas << "\n"
+    << "association.marking_position_sigma_m: " << o.association.marking_position_sigma_m << "\n"
+    << "association.lane_max_point_score_m2: " << o.association.lane_max_point_score_m2 << "\n"
+    << "association.lane_gate_m: " << o.association.lane_gate_m << "\n";
+  const AssociationOptions gates = EffectiveAssociationOptions(o);
+  s << "association floors (with the odometry's " << gates.odometry_sigma_m << " m): marking "
+    << MarkingFloorSigma(gates) << " m, lane " << LaneFloorSigma(gates) << " m\n";
+  return s.str();
+}
+
+}  // namespace ipm_road_mapper

@@ -1,0 +1,162 @@
+// Extrinsic (with its IPM grid error) and pose evaluation.
+#include <algorithm>
+#include <cmath>
+
+#include "ipm_road_mapper/eval/evaluation.h"
+#include "ipm_road_mapper/core/geometry/ipm.h"
+
+namespace ipm_road_mapper {
+namespace {
+
+constexpr double kRadToDeg = 180.0 / M_PI;
+// The IPM grid must not lose pixels to the range check: the band limits select them.
+constexpr double kUnlimitedRange_m = 1e9;
+
+// Roll, pitch, yaw (deg) of the rotation R_est R_true^T, i.e. the error as a rotation about
+// the axes of the frame both transforms map into (base_link for extrinsics).
+Eigen::Vector3d RpyErrorDeg(const Eigen::Isometry3d& T_est, const Eigen::Isometry3d& T_true) {
+  return RpyFromRotation(T_est.linear() * T_true.linear().transpose()) * kRadToDeg;
+}
+
+// |yaw(T_est) - yaw(T_true)| wrapped to [0, 180] deg.
+double YawErrorDeg(const Eigen::Isometry3d& T_est, const Eigen::Isometry3d& T_true) {
+  const double yaw_diff =
+      RpyFromRotation(T_est.linear()).z() - RpyFromRotation(T_true.linear()).z();
+  return std::abs(std::remainder(yaw_diff, 2.0 * M_PI)) * kRadToDeg;
+}
+
+// Mean ground distance between the IPM of grid pixels under T_base_cam_est and under the
+// truth, over the pixels whose true ground point is in the evaluation band.
+ErrorSummary IpmGridError(const GroundTruth& gt, const Eigen::Isometry3d& T_base_cam_est,
+                          const EvaluationOptions& options, int* pixels, int* failed) {
+  *pixels = 0;
+  *failed = 0;
+  const PinholeCamera camera(gt.camera);
+  if (!camera.Validate().empty() || options.ipm_grid_step_px <= 0) return {};
+  const Ipm ipm_true(camera, gt.T_base_cam_true, kUnlimitedRange_m);
+  const Ipm ipm_est(camera, T_base_cam_est, kUnlimitedRange_m);
+  const int step = options.ipm_grid_step_px;
+  std::vector<double> errors;
+  for (int v = step / 2; v < camera.height(); v += step) {
+    for (int u = step / 2; u < camera.width(); u += step) {
+      const Eigen::Vector2d uv(u, v);
+      Eigen::Vector3d p_base_true, p_base_est;
+      if (ipm_true.PixelToGround(uv, &p_base_true) != IpmStatus::kOk) continue;
+      if (p_base_true.x() < options.ipm_grid_min_ahead_m ||
+          p_base_true.x() > options.ipm_grid_max_ahead_m) {
+        continue;
+      }
+      ++*pixels;
+      if (ipm_est.PixelToGround(uv, &p_base_est) != IpmStatus::kOk) {
+        ++*failed;
+        continue;
+      }
+      errors.push_back((p_base_est - p_base_true).norm());
+    }
+  }
+  return Summarize(std::move(errors));
+}
+
+// Index of the GT frame nearest in stamp to `stamp`, or -1 beyond the tolerance.
+// `order` holds frame indices sorted by stamp.
+int NearestFrame(const GroundTruth& gt, const std::vector<int>& order, double stamp,
+                 double tolerance_s) {
+  const auto after = std::lower_bound(order.begin(), order.end(), stamp,
+                                      [&](int i, double s) { return gt.frames[i].stamp < s; });
+  int best = -1;
+  double best_dt = tolerance_s;
+  for (auto it : {after - (after == order.begin() ? 0 : 1), after}) {
+    if (it == order.end()) continue;
+    const double dt = std::abs(gt.frames[*it].stamp - stamp);
+    if (dt <= best_dt) {
+      best_dt = dt;
+      best = *it;
+    }
+  }
+  return best;
+}
+
+}  // namespace
+
+ExtrinsicMetrics EvaluateExtrinsic(const VectorMap& map, const GroundTruth& gt,
+                                   const EvaluationOptions& options) {
+  ExtrinsicMetrics m;
+  const Eigen::Isometry3d& T_true = gt.T_base_cam_true;
+  m.rot_err_deg = RotationAngleBetween(map.T_base_cam, T_true) * kRadToDeg;
+  m.rot_err_deg_initial = RotationAngleBetween(map.T_base_cam_initial, T_true) * kRadToDeg;
+  m.rpy_err_deg = RpyErrorDeg(map.T_base_cam, T_true);
+  m.rpy_err_deg_initial = RpyErrorDeg(map.T_base_cam_initial, T_true);
+  m.trans_err_xyz_m = map.T_base_cam.translation() - T_true.translation();
+  m.trans_err_xyz_m_initial = map.T_base_cam_initial.translation() - T_true.translation();
+  m.trans_err_m = m.trans_err_xyz_m.norm();
+  m.trans_err_m_initial = m.trans_err_xyz_m_initial.norm();
+  int pixels_initial = 0;
+  m.ipm_grid_err_m =
+      IpmGridError(gt, map.T_base_cam, options, &m.ipm_grid_pixels, &m.ipm_grid_failed);
+  m.ipm_grid_err_m_initial = IpmGridError(gt, map.T_base_cam_initial, options, &pixels_initial,
+                                          &m.ipm_grid_failed_initial);
+  return m;
+}
+
+PoseMetrics EvaluatePoses(const VectorMap& map, const GroundTruth& gt,
+                          const EvaluationOptions& options) {
+  PoseMetrics metrics;
+  metrics.has_trajectory = !map.trajectory.empty();
+  // Pairs (GT frame, corrected pose or nullptr): the map's poses matched by stamp, or every
+  // GT frame when the map has no trajectory (then only the odometry is measured).
+  std::vector<std::pair<int, const StampedPose*>> pairs;
+  if (metrics.has_trajectory) {
+    std::vector<int> order(gt.frames.size());
+    for (std::size_t i = 0; i < order.size(); ++i) order[i] = static_cast<int>(i);
+    std::sort(order.begin(), order.end(),
+              [&](int a, int b) { return gt.frames[a].stamp < gt.frames[b].stamp; });
+    for (const StampedPose& pose : map.trajectory) {
+      const int frame = NearestFrame(gt, order, pose.stamp, options.pose_stamp_tolerance_s);
+      if (frame < 0) {
+        ++metrics.map_poses_unmatched;
+      } else {
+        pairs.emplace_back(frame, &pose);
+      }
+    }
+  } else {
+    for (std::size_t i = 0; i < gt.frames.size(); ++i) {
+      pairs.emplace_back(static_cast<int>(i), nullptr);
+    }
+  }
+
+  std::vector<double> trans, rot, yaw, trans_input, rot_input, yaw_input;
+  for (const auto& [frame_index, pose] : pairs) {
+    const GroundTruthFrame& frame = gt.frames[frame_index];
+    PoseFrameError e;
+    e.stamp = frame.stamp;
+    e.trans_err_m_input =
+        (frame.T_map_base_odom.translation() - frame.T_map_base_true.translation()).norm();
+    e.rot_err_deg_input =
+        RotationAngleBetween(frame.T_map_base_odom, frame.T_map_base_true) * kRadToDeg;
+    e.yaw_err_deg_input = YawErrorDeg(frame.T_map_base_odom, frame.T_map_base_true);
+    trans_input.push_back(e.trans_err_m_input);
+    rot_input.push_back(e.rot_err_deg_input);
+    yaw_input.push_back(e.yaw_err_deg_input);
+    if (pose == nullptr) {
+      e.trans_err_m = e.rot_err_deg = e.yaw_err_deg = kNoValue;
+    } else {
+      e.trans_err_m = (pose->T_map_base.translation() - frame.T_map_base_true.translation()).norm();
+      e.rot_err_deg = RotationAngleBetween(pose->T_map_base, frame.T_map_base_true) * kRadToDeg;
+      e.yaw_err_deg = YawErrorDeg(pose->T_map_base, frame.T_map_base_true);
+      trans.push_back(e.trans_err_m);
+      rot.push_back(e.rot_err_deg);
+      yaw.push_back(e.yaw_err_deg);
+    }
+    metrics.frames.push_back(e);
+  }
+  metrics.frames_matched = metrics.has_trajectory ? static_cast<int>(pairs.size()) : 0;
+  metrics.trans_err_m = Summarize(std::move(trans));
+  metrics.rot_err_deg = Summarize(std::move(rot));
+  metrics.yaw_err_deg = Summarize(std::move(yaw));
+  metrics.trans_err_m_input = Summarize(std::move(trans_input));
+  metrics.rot_err_deg_input = Summarize(std::move(rot_input));
+  metrics.yaw_err_deg_input = Summarize(std::move(yaw_input));
+  return metrics;
+}
+
+}  // namespace ipm_road_mapper

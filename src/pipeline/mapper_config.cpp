@@ -1,0 +1,101 @@
+#include "ipm_road_mapper/pipeline/mapper_config.h"
+
+#include <cstdlib>
+#include <filesystem>
+#include <sstream>
+#include <vector>
+
+namespace ipm_road_mapper {
+namespace {
+
+namespace fs = std::filesystem;
+
+std::string CheckQueueSize(const int& v) {
+  return v >= 1 && v <= 100000 ? "" : "must be in [1, 100000] (got " + std::to_string(v) + ")";
+}
+
+std::string CheckFrameName(const std::string& v) {
+  if (v.empty()) return "";
+  if (v.find_first_of(" \t\n") != std::string::npos) return "must not contain spaces";
+  if (v[0] == '/') return "must not start with '/' (tf2 frame ids have no leading slash)";
+  return "";
+}
+
+}  // namespace
+
+RosOptions LoadRosOptions(OptionsReader reader) {
+  RosOptions o;
+  reader.Read<double>("publish_rate_hz", &o.publish_rate_hz, [](const double& v) {
+    return v > 0.0 && v <= 100.0 ? "" : "must be in (0, 100] Hz";
+  });
+  reader.Read<std::string>("map_frame", &o.map_frame, CheckFrameName);
+  reader.Read<std::string>("refined_camera_frame", &o.refined_camera_frame, CheckFrameName);
+  reader.Read<std::string>("save_map_path", &o.save_map_path);
+  reader.Read<std::string>("classes_file", &o.classes_file);
+  reader.Read<int>("sync_queue_size", &o.sync_queue_size, CheckQueueSize);
+  reader.Read<double>("approximate_sync_max_interval_s", &o.approximate_sync_max_interval_s,
+                      CheckPositive);
+  reader.Read<int>("odom_queue_size", &o.odom_queue_size, CheckQueueSize);
+  reader.Read<double>("odometry_wait_s", &o.odometry_wait_s, CheckNonNegative);
+  reader.Read<int>("path_max_poses", &o.path_max_poses, CheckPositiveInt);
+  reader.Read<double>("diagnostics_period_s", &o.diagnostics_period_s, CheckPositive);
+  reader.Read<double>("debug_image_rate_hz", &o.debug_image_rate_hz, CheckPositive);
+  reader.RejectUnknownKeys();
+  return o;
+}
+
+MapperConfig LoadMapperConfig(OptionsReader reader) {
+  MapperConfig config;
+  config.geo_origin = LoadGeoOrigin(reader.Child("geo_origin"));
+  config.ros = LoadRosOptions(reader.Child("ros"));
+  // LoadMapperOptions takes its reader by value: the copy knows that geo_origin and ros
+  // were read, so it rejects only keys that nobody asked for.
+  config.mapper = LoadMapperOptions(reader);
+  return config;
+}
+
+MapperConfig LoadMapperConfigFile(const std::string& path) {
+  try {
+    return LoadMapperConfig(OptionsReader::FromFile(path));
+  } catch (const OptionsError& e) {
+    const std::string what = e.what();
+    throw OptionsError(what.rfind(path, 0) == 0 ? what : path + ": " + what);
+  }
+}
+
+std::string ToString(const RosOptions& o) {
+  std::ostringstream s;
+  auto or_default = [](const std::string& v, const char* fallback) {
+    return v.empty() ? std::string(fallback) : v;
+  };
+  s << "ros.publish_rate_hz: " << o.publish_rate_hz << "\n"
+    << "ros.map_frame: " << or_default(o.map_frame, "(odometry header.frame_id)") << "\n"
+    << "ros.refined_camera_frame: " << or_default(o.refined_camera_frame, "(<camera>_refined)")
+    << "\n"
+    << "ros.save_map_path: " << or_default(o.save_map_path, "(none: not saved at shutdown)") << "\n"
+    << "ros.classes_file: " << or_default(o.classes_file, "(package config/classes.yaml)") << "\n"
+    << "ros.sync_queue_size: " << o.sync_queue_size << "\n"
+    << "ros.approximate_sync_max_interval_s: " << o.approximate_sync_max_interval_s << "\n"
+    << "ros.odom_queue_size: " << o.odom_queue_size << "\n"
+    << "ros.odometry_wait_s: " << o.odometry_wait_s << "\n"
+    << "ros.path_max_poses: " << o.path_max_poses << "\n"
+    << "ros.diagnostics_period_s: " << o.diagnostics_period_s << "\n"
+    << "ros.debug_image_rate_hz: " << o.debug_image_rate_hz << "\n";
+  return s.str();
+}
+
+std::string FindPackageFile(const std::string& package_path, const std::string& relative) {
+  std::vector<std::string> roots;
+  if (!package_path.empty()) roots.push_back(package_path);
+  if (const char* source_dir = std::getenv("IRM_SOURCE_DIR")) roots.push_back(source_dir);
+  std::error_code error;
+  const fs::path exe = fs::read_symlink("/proc/self/exe", error);
+  if (!error) roots.push_back((exe.parent_path() / "../../share/ipm_road_mapper").string());
+  for (const std::string& root : roots) {
+    if (fs::exists(fs::path(root) / relative)) return (fs::path(root) / relative).string();
+  }
+  throw OptionsError("cannot find the package's " + relative + " (set ROS_PACKAGE_PATH or " +
+                     "IRM_SOURCE_DIR, or pass the file explicitly)");
+}
+
+}  // namespace ipm_road_mapper
