@@ -6,85 +6,13 @@
 #include <opencv2/imgproc.hpp>
 
 #include "ipm_road_mapper/core/geometry/ipm.h"
+#include "common/road_scene.h"
 #include "ipm_road_mapper/core/mapper/mapper.h"
 
 namespace ipm_road_mapper {
 namespace {
 
-CameraIntrinsics TestCamera() {
-  CameraIntrinsics c;
-  c.width = 1280;
-  c.height = 720;
-  c.fx = c.fy = 1000.0;
-  c.cx = 640.0;
-  c.cy = 360.0;
-  return c;
-}
-
-// Camera 1.5 m high, 1.5 m ahead of base_link, pitched down 5 degrees.
-Eigen::Isometry3d TestExtrinsic() {
-  Eigen::Matrix3d R_base_optical;
-  R_base_optical << 0, 0, 1, -1, 0, 0, 0, -1, 0;
-  Eigen::Isometry3d T = Eigen::Isometry3d::Identity();
-  T.linear() = RotationFromRpy(0.0, 5.0 * M_PI / 180.0, 0.0) * R_base_optical;
-  T.translation() = Eigen::Vector3d(1.5, 0.0, 1.5);
-  return T;
-}
-
-ClassTable TestClasses() {
-  return ClassTable::Load(OptionsReader(YAML::Load(R"(
-classes:
-  - {id: 2, name: lane_white_dashed, kind: lane, style: dashed}
-  - {id: 10, name: arrow_straight, kind: marking}
-)"),
-                                        ""));
-}
-
-// Fills the ground polygon (map frame, z = 0) seen from T_map_base into the mask.
-void FillGround(const std::vector<Eigen::Vector3d>& polygon_map,
-                const Eigen::Isometry3d& T_map_base, int value, cv::Mat* mask) {
-  const Ipm ipm(PinholeCamera(TestCamera()), TestExtrinsic(), 100.0);
-  std::vector<cv::Point> pixels;
-  for (std::size_t i = 0; i < polygon_map.size(); ++i) {
-    const Eigen::Vector3d a = polygon_map[i], b = polygon_map[(i + 1) % polygon_map.size()];
-    for (int k = 0; k < 20; ++k) {
-      Eigen::Vector2d uv;
-      const Eigen::Vector3d p_base = T_map_base.inverse() * (a + (b - a) * (k / 20.0));
-      if (!ipm.BaseToPixel(p_base, &uv)) return;
-      pixels.emplace_back(static_cast<int>(std::lround(uv.x())),
-                          static_cast<int>(std::lround(uv.y())));
-    }
-  }
-  cv::fillPoly(*mask, std::vector<std::vector<cv::Point>>{pixels}, cv::Scalar(value));
-}
-
-std::vector<Eigen::Vector3d> Rect(double x0, double x1, double y0, double y1) {
-  return {{x0, y0, 0}, {x1, y0, 0}, {x1, y1, 0}, {x0, y1, 0}};
-}
-
-Eigen::Isometry3d PoseAt(double x) {
-  Eigen::Isometry3d T = Eigen::Isometry3d::Identity();
-  T.translation().x() = x;
-  return T;
-}
-
-// A frame with an arrow at x in [20, 23] m, y in [-0.3, 0.3] m, and a dashed lane at
-// y = 1.8 m (3 m dashes, 6 m period), seen from base_link at x_vehicle.
-FrameInput RoadFrame(double stamp, double x_vehicle, bool with_arrow = true) {
-  FrameInput in;
-  in.stamp = stamp;
-  in.camera = TestCamera();
-  in.T_map_base_odom = PoseAt(x_vehicle);
-  in.mask = cv::Mat::zeros(720, 1280, CV_16UC1);
-  for (double x = 0.0; x < 120.0; x += 6.0) {
-    if (x < x_vehicle + 4.0 || x > x_vehicle + 35.0) continue;
-    FillGround(Rect(x, x + 3.0, 1.725, 1.875), in.T_map_base_odom, 2001, &in.mask);
-  }
-  if (with_arrow && x_vehicle + 6.0 < 20.0) {
-    FillGround(Rect(20.0, 23.0, -0.3, 0.3), in.T_map_base_odom, 10001, &in.mask);
-  }
-  return in;
-}
+using namespace test;  // NOLINT: the scene's helpers
 
 // The front end alone (the back end has its own tests).
 Mapper MakeMapper() {

@@ -6,28 +6,36 @@ namespace ipm_road_mapper {
 
 RoadSurfaceEstimate RoadSurfaceNear(const std::vector<Eigen::Isometry3d>& T_map_base,
                                     const Eigen::Vector3d& p_map, double radius_m) {
-  RoadSurfaceEstimate estimate;
+  if (T_map_base.empty()) return RoadSurfaceEstimate();
   double closest = std::numeric_limits<double>::infinity();
   std::size_t closest_index = 0;
-  Eigen::Vector3d origin_sum = Eigen::Vector3d::Zero(), normal_sum = Eigen::Vector3d::Zero();
+  std::vector<const Eigen::Isometry3d*> within;
   for (std::size_t i = 0; i < T_map_base.size(); ++i) {
     const double d = (T_map_base[i].translation() - p_map).head<2>().norm();
     if (d < closest) {
       closest = d;
       closest_index = i;
     }
-    if (d <= radius_m) {
-      origin_sum += T_map_base[i].translation();
-      normal_sum += T_map_base[i].linear().col(2);
-      ++estimate.frames;
-    }
+    if (d <= radius_m) within.push_back(&T_map_base[i]);
   }
-  if (T_map_base.empty()) return estimate;
-  estimate.distance_m = closest;
+  return RoadSurfaceFromPoses(within, T_map_base[closest_index], closest);
+}
+
+RoadSurfaceEstimate RoadSurfaceFromPoses(const std::vector<const Eigen::Isometry3d*>& within,
+                                         const Eigen::Isometry3d& T_map_base_closest,
+                                         double closest_distance_m) {
+  RoadSurfaceEstimate estimate;
+  Eigen::Vector3d origin_sum = Eigen::Vector3d::Zero(), normal_sum = Eigen::Vector3d::Zero();
+  for (const Eigen::Isometry3d* T : within) {
+    origin_sum += T->translation();
+    normal_sum += T->linear().col(2);
+  }
+  estimate.frames = static_cast<int>(within.size());
+  estimate.distance_m = closest_distance_m;
   if (estimate.frames == 0) {
     estimate.frames = 1;
-    origin_sum = T_map_base[closest_index].translation();
-    normal_sum = T_map_base[closest_index].linear().col(2);
+    origin_sum = T_map_base_closest.translation();
+    normal_sum = T_map_base_closest.linear().col(2);
   } else {
     origin_sum /= estimate.frames;
   }

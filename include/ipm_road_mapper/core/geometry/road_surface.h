@@ -29,4 +29,10 @@ struct RoadSurfaceEstimate {
 RoadSurfaceEstimate RoadSurfaceNear(const std::vector<Eigen::Isometry3d>& T_map_base,
                                     const Eigen::Vector3d& p_map, double radius_m);
 
+// The same estimate from poses already selected: `within` (the poses within the radius, in
+// frame order; may be empty) and the closest pose with its horizontal distance.
+RoadSurfaceEstimate RoadSurfaceFromPoses(const std::vector<const Eigen::Isometry3d*>& within,
+                                         const Eigen::Isometry3d& T_map_base_closest,
+                                         double closest_distance_m);
+
 }  // namespace ipm_road_mapper

@@ -1,12 +1,11 @@
-// The lane half of the Mapper's front end: point selection, association, starting a lane
-// with g, growing its ends (FitLaneEnds), merging lanes that turn out to be one line, and the
-// re-fit of lanes that no lane residual refines.
+#include "ipm_road_mapper/core/mapper/lane_tracker.h"
+
 #include <algorithm>
+#include <cmath>
 
 #include "ipm_road_mapper/core/frontend/association.h"
 #include "ipm_road_mapper/core/geometry/ipm.h"
 #include "ipm_road_mapper/core/geometry/lane_end_fit.h"
-#include "ipm_road_mapper/core/mapper/mapper.h"
 #include "ipm_road_mapper/core/geometry/spline_fitting.h"
 
 namespace ipm_road_mapper {
@@ -37,19 +36,32 @@ double Extent(const std::vector<Eigen::Vector3d>& points) {
   return extent;
 }
 
+// The candidate's points usable for association and growth.
+std::vector<Eigen::Vector3d> UsablePoints(const LaneCandidate& candidate) {
+  std::vector<Eigen::Vector3d> usable_map;
+  for (std::size_t i = 0; i < candidate.points_map.size(); ++i) {
+    if (candidate.usable[i]) usable_map.push_back(candidate.points_map[i]);
+  }
+  return usable_map;
+}
+
 }  // namespace
 
-void Mapper::AddLanes(const FrameObservations& observations, const FrameRecord& frame) {
+LaneTracker::LaneTracker(const MapperOptions& options, MapStore* store, MapperCounters* counters)
+    : options_(options), store_(store), counters_(counters) {}
+
+void LaneTracker::Update(const std::vector<LaneObservation>& observations,
+                         const FrameRecord& frame) {
   std::vector<LaneCandidate> candidates;
   std::vector<LaneMeasurement> measurements;
-  for (const LaneObservation& obs : observations.lanes) {
+  const Eigen::Matrix2d R = frame.T_map_base.linear().topLeftCorner<2, 2>();
+  for (const LaneObservation& obs : observations) {
     LaneCandidate candidate;
     candidate.class_id = obs.class_id;
     LaneMeasurement measurement;
     measurement.frame_index = frame.index;
     measurement.points = obs.points;
     measurement.selected = SelectPoints(obs.points, options_.lanes);
-    const Eigen::Matrix2d R = frame.T_map_base.linear().topLeftCorner<2, 2>();
     for (std::size_t i = 0; i < obs.points.size(); ++i) {
       const Eigen::Vector3d p_map = frame.T_map_base * obs.points[i].p_base;
       candidate.points_map.push_back(p_map);
@@ -61,35 +73,30 @@ void Mapper::AddLanes(const FrameObservations& observations, const FrameRecord& 
     candidates.push_back(std::move(candidate));
     measurements.push_back(std::move(measurement));
   }
-  const std::vector<int> match = AssociateLanes(map_.lanes, candidates, options_.association);
+  std::vector<LaneElement>& lanes = store_->lanes();
+  const std::vector<int> match = AssociateLanes(lanes, candidates, options_.association);
   for (std::size_t c = 0; c < candidates.size(); ++c) {
+    // The start gate looks at every point of low enough uncertainty: the N best of PS alone
+    // may all lie on the nearest dash of a dashed line, shorter than the gate.
+    const std::vector<Eigen::Vector3d> usable_map = UsablePoints(candidates[c]);
     if (match[c] < 0) {
-      // The start gate looks at every point of low enough uncertainty: the N best of PS
-      // alone may all lie on the nearest dash of a dashed line, shorter than the gate.
-      std::vector<Eigen::Vector3d> usable_map;
-      for (std::size_t i = 0; i < candidates[c].points_map.size(); ++i) {
-        if (candidates[c].usable[i]) usable_map.push_back(candidates[c].points_map[i]);
-      }
-      StartLane(candidates[c].class_id, measurements[c], usable_map, frame);
+      Start(candidates[c].class_id, measurements[c], usable_map, frame);
       continue;
     }
-    LaneElement& lane = map_.lanes[match[c]];
+    LaneElement& lane = lanes[match[c]];
     lane.history.push_back(std::move(measurements[c]));
     lane.last_frame = frame.index;
     lane.last_seen = frame.stamp;
-    std::vector<Eigen::Vector3d> usable_map;
-    for (std::size_t i = 0; i < candidates[c].points_map.size(); ++i) {
-      if (candidates[c].usable[i]) usable_map.push_back(candidates[c].points_map[i]);
-    }
-    GrowLane(&lane, frame.index, usable_map);
+    Grow(&lane, frame.index, usable_map);
   }
-  if (map_.frames.size() % static_cast<std::size_t>(options_.lanes.merge_every_n_frames) == 0) {
-    MergeLanes();
+  if (store_->frames().size() % static_cast<std::size_t>(options_.lanes.merge_every_n_frames) ==
+      0) {
+    MergeLines();
   }
 }
 
-void Mapper::GrowLane(LaneElement* lane, std::size_t frame_index,
-                      const std::vector<Eigen::Vector3d>& usable_map) const {
+void LaneTracker::Grow(LaneElement* lane, std::size_t frame_index,
+                       const std::vector<Eigen::Vector3d>& usable_map) const {
   const std::size_t horizon = static_cast<std::size_t>(options_.lanes.end_fit_frames);
   std::vector<Eigen::Vector3d> points;
   for (auto m = lane->history.rbegin(); m != lane->history.rend(); ++m) {
@@ -102,26 +109,26 @@ void Mapper::GrowLane(LaneElement* lane, std::size_t frame_index,
   lane->first_cp_index -= added_at_start;  // keeps older back-end results applicable
 }
 
-void Mapper::StartLane(int class_id, const LaneMeasurement& measurement,
-                       const std::vector<Eigen::Vector3d>& usable_map, const FrameRecord& frame) {
+void LaneTracker::Start(int class_id, const LaneMeasurement& measurement,
+                        const std::vector<Eigen::Vector3d>& usable_map, const FrameRecord& frame) {
   if (Extent(usable_map) < options_.lanes.min_new_lane_length_m) {
-    ++counters_.lane_observations_unused;
+    ++counters_->lane_observations_unused;
     return;
   }
   AssociationOptions loose = options_.association;
   loose.lane_gate_m *= 2.0;
   loose.lane_gate_sigmas *= 2.0;
-  LaneCandidate candidate{class_id, usable_map, {}, {}};
-  for (const LaneElement& lane : map_.lanes) {
+  const LaneCandidate candidate{class_id, usable_map, {}, {}};
+  for (const LaneElement& lane : store_->lanes()) {
     if (LaneAssociationCost(lane, candidate, loose) >= 0.0) {
-      ++counters_.lane_observations_near_lane;
+      ++counters_->lane_observations_near_lane;
       return;
     }
   }
   auto control_points = EstimateControlPoints(measurement.selected_map, options_.lanes.fit);
   if (!control_points) control_points = EstimateControlPoints(usable_map, options_.lanes.fit);
   if (!control_points) {
-    ++counters_.lane_observations_unused;
+    ++counters_->lane_observations_unused;
     return;
   }
   // Ordered along the direction of travel, so that the lane mostly grows at its end.
@@ -130,21 +137,23 @@ void Mapper::StartLane(int class_id, const LaneMeasurement& measurement,
     std::reverse(control_points->begin(), control_points->end());
   }
   LaneElement lane;
-  lane.id = map_.next_id++;
+  lane.id = store_->NewId();
   lane.class_id = class_id;
   lane.control_points_map = std::move(*control_points);
   lane.history.push_back(measurement);
   lane.first_frame = lane.last_frame = frame.index;
   lane.first_seen = lane.last_seen = frame.stamp;
-  map_.lanes.push_back(std::move(lane));
-  ++counters_.lanes_created;
+  store_->lanes().push_back(std::move(lane));
+  ++counters_->lanes_created;
 }
 
-std::vector<Eigen::Vector3d> Mapper::SelectedPointsMap(const LaneElement& lane) const {
-  const Ipm ipm(PinholeCamera(camera_), T_base_cam_, options_.ipm.max_range_m);
+std::vector<Eigen::Vector3d> LaneTracker::RefitControlPoints(
+    const LaneElement& lane, const CameraIntrinsics& camera,
+    const Eigen::Isometry3d& T_base_cam) const {
+  const Ipm ipm(PinholeCamera(camera), T_base_cam, options_.ipm.max_range_m);
   std::vector<Eigen::Vector3d> points;
   for (const LaneMeasurement& m : lane.history) {
-    const Eigen::Isometry3d& T_map_base = map_.frames[m.frame_index].T_map_base;
+    const Eigen::Isometry3d& T_map_base = store_->frames()[m.frame_index].T_map_base;
     for (std::size_t i = 0; i < m.points.size(); ++i) {
       Eigen::Vector3d p_base;
       if (m.selected[i] && ipm.PixelToGround(m.points[i].uv, &p_base) == IpmStatus::kOk) {
@@ -152,20 +161,17 @@ std::vector<Eigen::Vector3d> Mapper::SelectedPointsMap(const LaneElement& lane) 
       }
     }
   }
-  return points;
+  return FitLaneEnds(lane.control_points_map, points, options_.lanes.end_fit);
 }
 
-std::vector<Eigen::Vector3d> Mapper::RefitControlPoints(const LaneElement& lane) const {
-  return FitLaneEnds(lane.control_points_map, SelectedPointsMap(lane), options_.lanes.end_fit);
-}
-
-void Mapper::MergeLanes() {
+void LaneTracker::MergeLines() {
   // Two lanes of one class that turn out to be one line (e.g. one was started while the
   // other was not matched across a gap): the second's curve lies along the first.
-  for (std::size_t a = 0; a < map_.lanes.size(); ++a) {
-    for (std::size_t b = a + 1; b < map_.lanes.size();) {
-      LaneElement& first = map_.lanes[a];
-      LaneElement& second = map_.lanes[b];
+  std::vector<LaneElement>& lanes = store_->lanes();
+  for (std::size_t a = 0; a < lanes.size(); ++a) {
+    for (std::size_t b = a + 1; b < lanes.size();) {
+      LaneElement& first = lanes[a];
+      LaneElement& second = lanes[b];
       LaneCandidate candidate;
       candidate.class_id = second.class_id;
       candidate.points_map = second.control_points_map;          // ordered along the lane
@@ -194,10 +200,23 @@ void Mapper::MergeLanes() {
       first.control_points_map =
           FitLaneEnds(first.control_points_map, points, options_.lanes.end_fit, &added_at_start);
       first.first_cp_index -= added_at_start;
-      map_.lanes.erase(map_.lanes.begin() + b);
-      ++counters_.lanes_merged;
+      lanes.erase(lanes.begin() + b);
+      ++counters_->lanes_merged;
     }
   }
+}
+
+void LaneTracker::DropSpurious(std::size_t frame_index) {
+  const std::size_t horizon = options_.association.spurious_after_frames;
+  std::vector<LaneElement>& lanes = store_->lanes();
+  const std::size_t before = lanes.size();
+  lanes.erase(std::remove_if(lanes.begin(), lanes.end(),
+                             [&](const LaneElement& e) {
+                               return e.history.size() == 1 &&
+                                      frame_index > e.last_frame + horizon;
+                             }),
+              lanes.end());
+  counters_->spurious_dropped += before - lanes.size();
 }
 
 }  // namespace ipm_road_mapper

@@ -1,0 +1,52 @@
+// The lane half of the front end: point selection (PS) on each lane observation,
+// association with the mapped lanes, starting a lane with g, growing its ends (FitLaneEnds),
+// merging lanes that turn out to be one line, dropping lanes seen once, and the re-fit of
+// lanes that no lane residual refines (export).
+#pragma once
+
+#include <Eigen/Geometry>
+#include <cstddef>
+#include <vector>
+
+#include "ipm_road_mapper/core/frontend/observations.h"
+#include "ipm_road_mapper/core/geometry/pinhole_camera.h"
+#include "ipm_road_mapper/core/mapper/map_store.h"
+#include "ipm_road_mapper/core/mapper/mapper_counters.h"
+#include "ipm_road_mapper/core/mapper/mapper_options.h"
+
+namespace ipm_road_mapper {
+
+class LaneTracker {
+ public:
+  // `options.association` must be the effective gates (EffectiveAssociationOptions). The
+  // store and counters outlive the tracker.
+  LaneTracker(const MapperOptions& options, MapStore* store, MapperCounters* counters);
+
+  // One frame: associates its lane observations, starts or grows lanes; every
+  // lanes.merge_every_n_frames frames, merges lanes that are one line.
+  void Update(const std::vector<LaneObservation>& observations, const FrameRecord& frame);
+  // Drops the lanes seen in one frame only and not again for
+  // association.spurious_after_frames frames.
+  void DropSpurious(std::size_t frame_index);
+
+  // The lane's control points re-fit to all its selected pixels, IPMed with `T_base_cam`
+  // and the frames' current poses (export of lanes no lane residual refines).
+  std::vector<Eigen::Vector3d> RefitControlPoints(const LaneElement& lane,
+                                                  const CameraIntrinsics& camera,
+                                                  const Eigen::Isometry3d& T_base_cam) const;
+
+ private:
+  void Start(int class_id, const LaneMeasurement& measurement,
+             const std::vector<Eigen::Vector3d>& usable_map, const FrameRecord& frame);
+  // Grows the lane's ends with this frame's usable points and refines them with the
+  // selected points of its recent observations.
+  void Grow(LaneElement* lane, std::size_t frame_index,
+            const std::vector<Eigen::Vector3d>& usable_map) const;
+  void MergeLines();
+
+  const MapperOptions& options_;
+  MapStore* store_;
+  MapperCounters* counters_;
+};
+
+}  // namespace ipm_road_mapper

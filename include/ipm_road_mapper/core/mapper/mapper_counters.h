@@ -1,0 +1,43 @@
+// What the mapper did or refused, by reason (printed in summaries, published as
+// diagnostics, written into the map's metadata), and the front end's timings.
+#pragma once
+
+#include <cstdint>
+#include <map>
+#include <string>
+#include <vector>
+
+#include "ipm_road_mapper/core/frontend/observations.h"
+#include "ipm_road_mapper/core/mapper/timing_series.h"
+
+namespace ipm_road_mapper {
+
+// Counters of everything the mapper did or refused.
+struct MapperCounters {
+  std::uint64_t frames_received = 0;
+  std::uint64_t frames_used = 0;
+  std::map<std::string, std::uint64_t> frames_skipped;  // reason key -> count
+  ExtractionCounters extraction;
+  std::uint64_t markings_created = 0;
+  std::uint64_t lanes_created = 0;
+  std::uint64_t spurious_dropped = 0;
+  std::uint64_t lanes_merged = 0;
+  std::uint64_t markings_merged = 0;
+  std::uint64_t lane_observations_unused = 0;  // unmatched and too short / unfit to start a lane
+  // Unmatched but close to a lane of its class (within twice the gates): not a new line, so
+  // not started (a second spline along one line would be a duplicate).
+  std::uint64_t lane_observations_near_lane = 0;
+  std::uint64_t results_applied = 0;   // back-end results merged into the map
+  std::uint64_t results_rejected = 0;  // unusable (solver failure, trust bound)
+  std::uint64_t SkippedTotal() const;
+};
+
+// Wall time of the front end per used frame (mask -> observations -> map update; the back
+// end's snapshot and merges excluded), for the summaries and the benchmark; the most recent
+// frames only (timing_series.h).
+struct FrontEndTiming {
+  std::vector<float> extraction_ms;  // mask -> instances -> IPM measurements
+  std::vector<float> total_ms;       // extraction + orientation, association, map update
+};
+
+}  // namespace ipm_road_mapper

@@ -1,0 +1,49 @@
+// The marking half of the front end: each frame's marking observations re-oriented along
+// the road, associated with the mapped markings, turned into new elements or added to their
+// element's history (with the plain-IPM running mean of the corners until the back end owns
+// an element), elements that turn out to be one marking merged, and elements seen once and
+// never again dropped as spurious.
+#pragma once
+
+#include <cstddef>
+#include <vector>
+
+#include "ipm_road_mapper/core/frontend/observations.h"
+#include "ipm_road_mapper/core/geometry/ipm.h"
+#include "ipm_road_mapper/core/mapper/map_store.h"
+#include "ipm_road_mapper/core/mapper/mapper_counters.h"
+#include "ipm_road_mapper/core/mapper/mapper_options.h"
+
+namespace ipm_road_mapper {
+
+class MarkingTracker {
+ public:
+  // `options.association` must be the effective gates (EffectiveAssociationOptions). The
+  // store and counters outlive the tracker.
+  MarkingTracker(const MapperOptions& options, MapStore* store, MapperCounters* counters);
+
+  // One frame: orients, associates, creates or extends elements, merges duplicates.
+  // Observations whose re-oriented rectangle leaves the image are dropped (and counted).
+  void Update(const Ipm& ipm, const FrameRecord& frame,
+              std::vector<MarkingObservation>* observations);
+  // Drops the elements seen in one frame only and not again for
+  // association.spurious_after_frames frames.
+  void DropSpurious(std::size_t frame_index);
+
+ private:
+  // Re-fits each observation's rectangle with sides along the road (the tangent of the
+  // nearest mapped lane): the ground truth's rectangles follow the road, and the vehicle's
+  // heading is 5 deg off it on a 150 m curve 15 m ahead.
+  void OrientAlongRoad(const Ipm& ipm, const FrameRecord& frame,
+                       std::vector<MarkingObservation>* observations);
+  void Associate(const std::vector<MarkingObservation>& observations, const FrameRecord& frame);
+  // Merges elements of one class closer than association.marking_merge_distance_m or whose
+  // rectangles overlap by association.marking_merge_overlap.
+  void MergeDuplicates();
+
+  const MapperOptions& options_;
+  MapStore* store_;
+  MapperCounters* counters_;
+};
+
+}  // namespace ipm_road_mapper

@@ -1,0 +1,206 @@
+#include "ipm_road_mapper/core/mapper/marking_tracker.h"
+
+#include <algorithm>
+#include <array>
+#include <cmath>
+#include <opencv2/imgproc.hpp>
+
+#include "ipm_road_mapper/core/frontend/association.h"
+#include "ipm_road_mapper/core/frontend/instance_extraction.h"
+
+namespace ipm_road_mapper {
+namespace {
+
+// Below this angle (rad) from base_link's x axis the extracted rectangle is kept.
+constexpr double kRoadAxisMinAngleRad = 1e-3;
+
+// Area of the intersection of two ground rectangles (x-y), over the smaller one's area.
+double OverlapOfSmaller(const std::array<Eigen::Vector3d, 4>& a,
+                        const std::array<Eigen::Vector3d, 4>& b) {
+  auto polygon = [](const std::array<Eigen::Vector3d, 4>& corners) {
+    std::vector<cv::Point2f> p;
+    for (const Eigen::Vector3d& c : corners) p.emplace_back(c.x(), c.y());
+    if (cv::contourArea(p, true) < 0.0) std::reverse(p.begin(), p.end());  // counterclockwise
+    return p;
+  };
+  const std::vector<cv::Point2f> pa = polygon(a), pb = polygon(b);
+  const double smaller = std::min(cv::contourArea(pa), cv::contourArea(pb));
+  if (!(smaller > 1e-6)) return 0.0;
+  std::vector<cv::Point2f> intersection;
+  const double area = cv::intersectConvexConvex(pa, pb, intersection, true);
+  return std::max(0.0, area) / smaller;
+}
+
+// Largest horizontal distance of a corner from the center.
+double Radius(const MarkingElement& e) {
+  double r = 0.0;
+  for (const Eigen::Vector3d& c : e.corners_map) r = std::max(r, (c - e.Center()).head<2>().norm());
+  return r;
+}
+
+// Moves `second`'s measurements into `first` (in first's corner order, one per frame: the
+// first's where both have one) and widens first's span.
+void Absorb(MarkingElement* first, const MarkingElement& second) {
+  const int shift = BestCyclicShift(first->corners_map, second.corners_map, nullptr);
+  for (const MarkingMeasurement& m : second.history) {
+    MarkingMeasurement reordered = m;
+    for (int i = 0; i < 4; ++i) {
+      reordered.corners_uv[i] = m.corners_uv[(i + shift) % 4];
+      reordered.corners_base[i] = m.corners_base[(i + shift) % 4];
+    }
+    first->history.push_back(std::move(reordered));
+  }
+  std::sort(first->history.begin(), first->history.end(),
+            [](const MarkingMeasurement& x, const MarkingMeasurement& y) {
+              return x.frame_index < y.frame_index;
+            });
+  first->history.erase(std::unique(first->history.begin(), first->history.end(),
+                                    [](const MarkingMeasurement& x, const MarkingMeasurement& y) {
+                                      return x.frame_index == y.frame_index;
+                                    }),
+                       first->history.end());
+  first->first_frame = std::min(first->first_frame, second.first_frame);
+  first->last_frame = std::max(first->last_frame, second.last_frame);
+  first->first_seen = std::min(first->first_seen, second.first_seen);
+  first->last_seen = std::max(first->last_seen, second.last_seen);
+  first->optimized = first->optimized || second.optimized;
+  if (second.center_cov_map.trace() < first->center_cov_map.trace()) {
+    first->center_cov_map = second.center_cov_map;
+  }
+}
+
+}  // namespace
+
+MarkingTracker::MarkingTracker(const MapperOptions& options, MapStore* store,
+                               MapperCounters* counters)
+    : options_(options), store_(store), counters_(counters) {}
+
+void MarkingTracker::Update(const Ipm& ipm, const FrameRecord& frame,
+                            std::vector<MarkingObservation>* observations) {
+  OrientAlongRoad(ipm, frame, observations);
+  Associate(*observations, frame);
+  MergeDuplicates();
+}
+
+void MarkingTracker::OrientAlongRoad(const Ipm& ipm, const FrameRecord& frame,
+                                     std::vector<MarkingObservation>* observations) {
+  if (store_->lanes().empty()) return;
+  const Eigen::Isometry3d T_base_map = frame.T_map_base.inverse();
+  for (auto it = observations->begin(); it != observations->end();) {
+    const Eigen::Vector3d tangent_map = store_->RoadDirectionAt(frame.T_map_base * it->center_base);
+    Eigen::Vector2d axis_base = (T_base_map.linear() * tangent_map).head<2>();
+    if (axis_base.norm() < 1e-9 ||
+        std::abs(std::atan2(axis_base.y(), axis_base.x())) < kRoadAxisMinAngleRad) {
+      ++it;
+      continue;
+    }
+    if (axis_base.x() < 0.0) axis_base = -axis_base;  // a rectangle has no direction
+    if (SetMarkingRectangle(ipm, options_.ipm.error_model, axis_base, &*it)) {
+      ++it;
+    } else {
+      it = observations->erase(it);  // its re-oriented corner leaves the image: not usable
+      ++counters_->extraction.dropped_range;
+    }
+  }
+}
+
+void MarkingTracker::Associate(const std::vector<MarkingObservation>& observations,
+                               const FrameRecord& frame) {
+  std::vector<MarkingCandidate> candidates;
+  candidates.reserve(observations.size());
+  const Eigen::Matrix2d R = frame.T_map_base.linear().topLeftCorner<2, 2>();
+  for (const MarkingObservation& obs : observations) {
+    MarkingCandidate candidate;
+    candidate.class_id = obs.class_id;
+    for (int i = 0; i < 4; ++i) candidate.corners_map[i] = frame.T_map_base * obs.corners_base[i];
+    candidate.center_cov_map = R * obs.center_cov_base * R.transpose();
+    candidates.push_back(candidate);
+  }
+  std::vector<MarkingElement>& markings = store_->markings();
+  const std::vector<int> match = AssociateMarkings(markings, candidates, options_.association);
+  for (std::size_t c = 0; c < candidates.size(); ++c) {
+    const MarkingObservation& obs = observations[c];
+    if (match[c] < 0) {
+      MarkingElement element;
+      element.id = store_->NewId();
+      element.class_id = obs.class_id;
+      element.corners_map = candidates[c].corners_map;
+      element.center_cov_map = candidates[c].center_cov_map;
+      element.history.push_back({frame.index, obs.corners_uv, obs.corners_base, obs.outline_uv});
+      element.first_frame = element.last_frame = frame.index;
+      element.first_seen = element.last_seen = frame.stamp;
+      markings.push_back(std::move(element));
+      ++counters_->markings_created;
+      continue;
+    }
+    MarkingElement& element = markings[match[c]];
+    const int shift = BestCyclicShift(element.corners_map, candidates[c].corners_map, nullptr);
+    MarkingMeasurement measurement;
+    measurement.frame_index = frame.index;
+    for (int i = 0; i < 4; ++i) {
+      measurement.corners_uv[i] = obs.corners_uv[(i + shift) % 4];
+      measurement.corners_base[i] = obs.corners_base[(i + shift) % 4];
+    }
+    measurement.outline_uv = obs.outline_uv;
+    element.history.push_back(measurement);
+    element.last_frame = frame.index;
+    element.last_seen = frame.stamp;
+    if (candidates[c].center_cov_map.trace() < element.center_cov_map.trace()) {
+      element.center_cov_map = candidates[c].center_cov_map;
+    }
+    if (element.optimized) continue;  // the back end owns the estimate
+    // Plain IPM estimate: the running mean of the observed corners in the map.
+    const double n = static_cast<double>(element.history.size());
+    for (int i = 0; i < 4; ++i) {
+      element.corners_map[i] +=
+          (candidates[c].corners_map[(i + shift) % 4] - element.corners_map[i]) / n;
+    }
+  }
+}
+
+void MarkingTracker::MergeDuplicates() {
+  // Two elements of one class at one place are one marking seen twice: typically a far
+  // observation that missed the element (its IPM was meters off) started a second one, or a
+  // close-range view (partly outside the image's useful part) did.
+  const AssociationOptions& o = options_.association;
+  const double gate2 = o.marking_merge_distance_m * o.marking_merge_distance_m;
+  auto same_marking = [&](const MarkingElement& x, const MarkingElement& y) {
+    const Eigen::Vector2d d = (x.Center() - y.Center()).head<2>();
+    if (d.squaredNorm() <= gate2) return true;
+    if (o.marking_merge_overlap <= 0.0) return false;
+    if (d.norm() > Radius(x) + Radius(y)) return false;  // rectangles that cannot touch
+    return OverlapOfSmaller(x.corners_map, y.corners_map) >= o.marking_merge_overlap;
+  };
+  std::vector<MarkingElement>& markings = store_->markings();
+  for (std::size_t a = 0; a < markings.size(); ++a) {
+    for (std::size_t b = a + 1; b < markings.size();) {
+      if (markings[a].class_id != markings[b].class_id || markings[a].retired ||
+          markings[b].retired || !same_marking(markings[a], markings[b])) {
+        ++b;
+        continue;
+      }
+      // The better-observed element stays (its id and its corners).
+      if (markings[b].history.size() > markings[a].history.size()) {
+        std::swap(markings[a], markings[b]);
+      }
+      Absorb(&markings[a], markings[b]);
+      markings.erase(markings.begin() + b);
+      ++counters_->markings_merged;
+    }
+  }
+}
+
+void MarkingTracker::DropSpurious(std::size_t frame_index) {
+  const std::size_t horizon = options_.association.spurious_after_frames;
+  std::vector<MarkingElement>& markings = store_->markings();
+  const std::size_t before = markings.size();
+  markings.erase(std::remove_if(markings.begin(), markings.end(),
+                                [&](const MarkingElement& e) {
+                                  return e.history.size() == 1 &&
+                                         frame_index > e.last_frame + horizon;
+                                }),
+                 markings.end());
+  counters_->spurious_dropped += before - markings.size();
+}
+
+}  // namespace ipm_road_mapper

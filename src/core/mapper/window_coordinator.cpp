@@ -1,0 +1,265 @@
+#include "ipm_road_mapper/core/mapper/window_coordinator.h"
+
+#include <algorithm>
+#include <cmath>
+#include <set>
+#include <unordered_map>
+
+#include "ipm_road_mapper/core/backend/extrinsic_marginalization.h"
+#include "ipm_road_mapper/core/frontend/marking_measurement.h"
+
+namespace ipm_road_mapper {
+namespace {
+
+// A marking enters the back end once it has been seen from this close: seen only from
+// 15-20 m, with the odometry's 0.1 m of noise on the baseline, its triangulated depth is off
+// by meters (4.5 m observed), worse than the front end's IPM average, and the association
+// then starts a duplicate. It corrects poses after one solve and this many observations.
+constexpr double kMatureRangeM = 15.0;
+constexpr std::size_t kMinMatureObservations = 5;
+
+// Whether the marking has been seen from within kMatureRangeM of base_link.
+bool SeenUpClose(const MarkingElement& m) {
+  for (const MarkingMeasurement& meas : m.history) {
+    const Eigen::Vector3d center = 0.25 * (meas.corners_base[0] + meas.corners_base[1] +
+                                           meas.corners_base[2] + meas.corners_base[3]);
+    if (center.head<2>().norm() <= kMatureRangeM) return true;
+  }
+  return false;
+}
+
+}  // namespace
+
+WindowCoordinator::WindowCoordinator(const MapperOptions& options,
+                                     const Eigen::Isometry3d& T_base_cam_initial,
+                                     MapStore* store, MapperCounters* counters)
+    : options_(options),
+      T_base_cam_initial_(T_base_cam_initial),
+      T_base_cam_(T_base_cam_initial),
+      store_(store),
+      counters_(counters),
+      extrinsic_prior_(T_base_cam_initial, options.backend.rotation_prior_sigma_rad,
+                       options.backend.translation_prior_sigma_m) {
+  if (options_.backend.enabled) backend_ = std::make_unique<Backend>(options_.backend);
+}
+
+WindowCoordinator::~WindowCoordinator() {
+  if (backend_) backend_->Stop();
+}
+
+bool WindowCoordinator::LanesRefined() const {
+  return backend_ && options_.backend.lane_residual != LaneResidual::kNone;
+}
+
+BackendStats WindowCoordinator::stats() const {
+  return backend_ ? backend_->stats() : BackendStats();
+}
+
+void WindowCoordinator::Reset() {
+  if (!backend_) return;
+  backend_->Stop();  // results of the old map must not land in the new one
+  backend_ = std::make_unique<Backend>(options_.backend);
+}
+
+void WindowCoordinator::OnFrameUsed(std::uint64_t frames_used, const CameraIntrinsics& camera) {
+  camera_ = camera;
+  if (backend_ && frames_used % options_.backend.solve_every_n_frames == 0) {
+    backend_->Submit(BuildSnapshot());
+  }
+}
+
+void WindowCoordinator::Finish() {
+  if (!backend_ || store_->frames().empty()) return;
+  backend_->Submit(BuildSnapshot());
+  backend_->WaitIdle();
+  ApplyResults();
+  FinalGlobalSolve();
+}
+
+double WindowCoordinator::RoadPriorSigma(const RoadSurfaceEstimate& road) const {
+  const BackendOptions& o = options_.backend;
+  return std::hypot(o.road_height_sigma_m, o.road_height_sigma_per_m * road.distance_m);
+}
+
+void WindowCoordinator::RetireMarking(MarkingElement* marking) {
+  marking->retired = true;
+  if (!options_.backend.optimize_extrinsic || !options_.backend.optimize_markings) return;
+  const PinholeCamera camera(camera_);
+  MarginalizationInput input;
+  input.points.assign(marking->corners_map.begin(), marking->corners_map.end());
+  // Corners re-measured on the road plane where the vehicle passed the marking.
+  const RoadSurfaceEstimate road = store_->RoadSurfaceAt(marking->Center());
+  const RoadPlane& plane = road.plane;
+  const Eigen::Vector3d axis = store_->RoadDirectionAt(marking->Center());
+  for (const MarkingMeasurement& m : marking->history) {
+    const Eigen::Isometry3d& T_map_base = store_->frames()[m.frame_index].T_map_base;
+    std::array<Eigen::Vector2d, 4> corners_uv = m.corners_uv;
+    if (axis.norm() > 0.0 && !m.outline_uv.empty()) {
+      std::array<Eigen::Vector2d, 4> on_plane;
+      if (MeasureCornersOnPlane(camera, T_map_base * T_base_cam_, plane, axis, marking->corners_map,
+                                m.outline_uv, &on_plane)) {
+        corners_uv = on_plane;
+      }
+    }
+    for (int c = 0; c < 4; ++c) input.corners.push_back({c, corners_uv[c], T_map_base});
+  }
+  if (options_.backend.optimize_z) {
+    for (int c = 0; c < 4; ++c) {
+      const RoadSurfaceEstimate at = store_->RoadSurfaceAt(marking->corners_map[c]);
+      input.road_priors.push_back({c, at.plane, RoadPriorSigma(at)});
+    }
+  }
+  extrinsic_prior_.Add(MarginalizeIntoExtrinsic(camera, extrinsic_prior_, T_base_cam_, input,
+                                                options_.backend.pixel_sigma_px,
+                                                options_.backend.robust_scale));
+}
+
+void WindowCoordinator::FinalGlobalSolve() {
+  const BackendOptions& o = options_.backend;
+  const std::vector<FrameRecord>& frames = store_->frames();
+  if (!o.final_global_solve || frames.empty() ||
+      frames.size() > static_cast<std::size_t>(o.final_global_max_frames)) {
+    return;
+  }
+  // Everything at once: all frames free, every marking that reached the back end and every
+  // lane with all their observations, the extrinsic with the mounting prior alone (all the
+  // data it summarizes is in the problem itself).
+  WindowSnapshot snapshot;
+  snapshot.sequence = next_sequence_++;
+  snapshot.camera = camera_;
+  snapshot.T_base_cam = T_base_cam_;
+  snapshot.extrinsic_prior =
+      ExtrinsicPrior(T_base_cam_initial_, o.rotation_prior_sigma_rad, o.translation_prior_sigma_m);
+  for (const MarkingElement& m : store_->markings()) {
+    if (!m.optimized) continue;
+    snapshot.markings.push_back({m.id, m.corners_map, m.history,
+                                 store_->RoadDirectionAt(m.Center()),
+                                 m.history.size() >= kMinMatureObservations});
+  }
+  for (const LaneElement& l : store_->lanes()) {
+    snapshot.lanes.push_back({l.id, l.first_cp_index, l.control_points_map, l.history});
+  }
+  for (const FrameRecord& f : frames) {
+    snapshot.frames.push_back({f.index, f.T_map_base, f.T_map_base_odom, true, f.stamp});
+  }
+  BackendOptions global = o;
+  global.rounds = o.final_global_rounds;
+  global.max_measurements_per_marking = std::max(o.max_measurements_per_marking, 30);
+  global.max_extrinsic_change_rad = 1e9;  // the trust bound guards windows, not this
+  global.max_extrinsic_change_m = 1e9;
+  const WindowResult result = SolveWindow(snapshot, global);
+  if (!result.usable) {
+    ++counters_->results_rejected;
+    return;
+  }
+  ApplyResult(result, /*include_retired=*/true);
+  ++counters_->results_applied;
+}
+
+WindowSnapshot WindowCoordinator::BuildSnapshot() {
+  const std::vector<FrameRecord>& frames = store_->frames();
+  const std::size_t window = static_cast<std::size_t>(options_.backend.window_frames);
+  const std::size_t first = frames.size() > window ? frames.size() - window : 0;
+  // Lanes keep the pixels of one more window of frames as context; older ones retire.
+  const std::size_t lane_first = first > window ? first - window : 0;
+  for (MarkingElement& m : store_->markings()) {
+    if (!m.retired && m.last_frame < first && m.optimized) RetireMarking(&m);
+    if (!m.retired && m.last_frame < first) m.retired = true;  // never reached the back end
+  }
+  // Lane observations older than that leave the windows. Their information about the
+  // extrinsic is not kept: marginalizing pixels of control points that later windows still
+  // refine (a lane is never done, its control points are shared along it) made the prior
+  // confidently wrong (0.5 deg of roll on the drive with odometry noise alone). The markings
+  // carry the extrinsic's long-term information.
+  for (LaneElement& l : store_->lanes()) {
+    l.retired_before_frame = std::max(l.retired_before_frame, lane_first);
+  }
+
+  WindowSnapshot snapshot;
+  snapshot.sequence = next_sequence_++;
+  snapshot.camera = camera_;
+  snapshot.T_base_cam = T_base_cam_;
+  snapshot.extrinsic_prior = extrinsic_prior_;
+  std::set<std::size_t> context;  // frames of older measurements of the window's elements
+  for (const MarkingElement& m : store_->markings()) {
+    if (m.last_frame < first) continue;  // outside the window: held fixed
+    if (!SeenUpClose(m)) continue;       // the front end's estimate until it is
+    WindowMarking wm{m.id, m.corners_map, m.history, store_->RoadDirectionAt(m.Center()),
+                     m.optimized && m.history.size() >= kMinMatureObservations};
+    for (const MarkingMeasurement& meas : m.history) {
+      if (meas.frame_index < first) context.insert(meas.frame_index);
+    }
+    snapshot.markings.push_back(std::move(wm));
+  }
+  for (const LaneElement& l : store_->lanes()) {
+    if (l.last_frame < first) continue;
+    WindowLane wl{l.id, l.first_cp_index, l.control_points_map, {}};
+    for (const LaneMeasurement& meas : l.history) {
+      if (meas.frame_index < std::max(lane_first, l.retired_before_frame)) continue;
+      wl.measurements.push_back(meas);
+      if (meas.frame_index < first) context.insert(meas.frame_index);
+    }
+    snapshot.lanes.push_back(std::move(wl));
+  }
+  for (std::size_t i : context) {
+    const FrameRecord& f = frames[i];
+    snapshot.frames.push_back({f.index, f.T_map_base, f.T_map_base_odom, false, f.stamp});
+  }
+  for (std::size_t i = first; i < frames.size(); ++i) {
+    const FrameRecord& f = frames[i];
+    snapshot.frames.push_back({f.index, f.T_map_base, f.T_map_base_odom, true, f.stamp});
+  }
+  return snapshot;
+}
+
+void WindowCoordinator::ApplyResults() {
+  if (!backend_) return;
+  for (const auto& result : backend_->TakeResults()) {
+    if (!result->usable) {
+      ++counters_->results_rejected;
+      continue;
+    }
+    ApplyResult(*result, false);
+    ++counters_->results_applied;
+  }
+}
+
+void WindowCoordinator::ApplyResult(const WindowResult& result, bool include_retired) {
+  T_base_cam_ = result.T_base_cam;  // fed forward to the next frames' IPM
+  for (const WindowFrame& f : result.frames) {
+    if (f.in_window && f.index < store_->frames().size()) {
+      store_->SetFramePose(f.index, f.T_map_base);
+    }
+  }
+  if (options_.backend.optimize_markings) {
+    std::unordered_map<std::uint64_t, MarkingElement*> by_id;
+    for (MarkingElement& m : store_->markings()) by_id.emplace(m.id, &m);
+    for (const WindowMarking& wm : result.markings) {
+      auto it = by_id.find(wm.id);
+      if (it == by_id.end() || (it->second->retired && !include_retired)) continue;
+      it->second->corners_map = wm.corners_map;
+      it->second->optimized = true;
+    }
+  }
+  if (!LanesRefined()) return;
+  std::unordered_map<std::uint64_t, LaneElement*> by_id;
+  for (LaneElement& lane : store_->lanes()) by_id.emplace(lane.id, &lane);
+  for (const WindowLane& wl : result.lanes) {
+    auto it = by_id.find(wl.id);
+    if (it == by_id.end()) continue;
+    LaneElement& lane = *it->second;
+    const std::int64_t offset = wl.first_cp_index - lane.first_cp_index;
+    const std::int64_t n_result = static_cast<std::int64_t>(wl.control_points_map.size());
+    const std::int64_t n_lane = static_cast<std::int64_t>(lane.control_points_map.size());
+    for (std::int64_t j = 0; j < n_result; ++j) {
+      const std::int64_t k = j + offset;
+      if (k < 0 || k >= n_lane) continue;
+      // A phantom end of the snapshot that has since become a real point: keep the new one.
+      if ((j == 0 && k != 0) || (j == n_result - 1 && k != n_lane - 1)) continue;
+      lane.control_points_map[k] = wl.control_points_map[j];
+    }
+    lane.optimized = true;
+  }
+}
+
+}  // namespace ipm_road_mapper

@@ -1,0 +1,99 @@
+// The lane tracker alone, on observations extracted from rendered masks: one dashed line is
+// one spline that grows as the vehicle drives, a short unmatched piece starts nothing, two
+// lanes along one line are merged, and the export re-fit follows a changed extrinsic.
+#include <gtest/gtest.h>
+
+#include "common/road_scene.h"
+#include "ipm_road_mapper/core/frontend/instance_extraction.h"
+#include "ipm_road_mapper/core/mapper/lane_tracker.h"
+
+namespace ipm_road_mapper {
+namespace {
+
+using namespace test;  // NOLINT: the scene's helpers
+
+struct Rig {
+  explicit Rig(MapperOptions o = MapperOptions()) : options(std::move(o)), store(4.0) {
+    options.association = EffectiveAssociationOptions(options);
+  }
+  void Step(const FrameInput& in) {
+    const Ipm ipm(PinholeCamera(in.camera), TestExtrinsic(), options.ipm.max_range_m);
+    FrameObservations obs = ExtractObservations(in.mask, classes, ipm, options.ipm.error_model,
+                                                options.extraction);
+    const FrameRecord& frame = store.AddFrame(in.stamp, in.T_map_base_odom);
+    tracker.Update(obs.lanes, frame);
+    tracker.DropSpurious(frame.index);
+  }
+  MapperOptions options;
+  ClassTable classes = TestClasses();
+  MapStore store;
+  MapperCounters counters;
+  LaneTracker tracker{options, &store, &counters};
+};
+
+double MaxX(const std::vector<Eigen::Vector3d>& cps) {
+  double x = -1e9;
+  for (std::size_t i = 1; i + 1 < cps.size(); ++i) x = std::max(x, cps[i].x());
+  return x;
+}
+
+TEST(LaneTracker, OneDashedLineIsOneGrowingSpline) {
+  Rig rig;
+  rig.Step(RoadFrame(100.0, 0.0, false));
+  ASSERT_EQ(rig.store.lanes().size(), 1u);
+  const double reach_first = MaxX(rig.store.lanes()[0].control_points_map);
+  for (int k = 1; k < 30; ++k) rig.Step(RoadFrame(100.0 + 0.05 * k, 1.0 * k, false));
+  ASSERT_EQ(rig.store.lanes().size(), 1u);
+  const LaneElement& lane = rig.store.lanes()[0];
+  EXPECT_EQ(lane.history.size(), 30u);
+  EXPECT_GT(MaxX(lane.control_points_map), reach_first + 20.0);
+  for (std::size_t i = 1; i + 1 < lane.control_points_map.size(); ++i) {
+    EXPECT_NEAR(lane.control_points_map[i].y(), 1.8, 0.1);
+  }
+  EXPECT_EQ(rig.counters.lanes_created, 1u);
+}
+
+TEST(LaneTracker, TwoLanesAlongOneLineAreMerged) {
+  MapperOptions options;
+  options.lanes.merge_every_n_frames = 1;
+  Rig rig(options);
+  rig.Step(RoadFrame(100.0, 0.0, false));
+  ASSERT_EQ(rig.store.lanes().size(), 1u);
+  // A second lane of the same class along the same line, 30 m further (a line restarted
+  // after a gap): merged into the first at the next frame.
+  LaneElement second = rig.store.lanes()[0];
+  second.id = rig.store.NewId();
+  for (Eigen::Vector3d& c : second.control_points_map) c.x() += 9.0;
+  rig.store.lanes().push_back(second);
+  rig.Step(RoadFrame(100.05, 1.0, false));
+  EXPECT_EQ(rig.store.lanes().size(), 1u);
+  EXPECT_EQ(rig.counters.lanes_merged, 1u);
+  EXPECT_EQ(rig.store.lanes()[0].history.size(), 3u);  // both histories and the new frame
+}
+
+TEST(LaneTracker, ShortUnmatchedPieceStartsNoLane) {
+  Rig rig;
+  FrameInput in = RoadFrame(100.0, 0.0, false);
+  in.mask.setTo(0);
+  FillGround(Rect(8.0, 9.0, 1.725, 1.875), in.T_map_base_odom, 2001, &in.mask);  // 1 m dash
+  rig.Step(in);
+  EXPECT_TRUE(rig.store.lanes().empty());
+  EXPECT_EQ(rig.counters.lane_observations_unused, 1u);
+}
+
+TEST(LaneTracker, RefitFollowsTheExtrinsic) {
+  Rig rig;
+  for (int k = 0; k < 5; ++k) rig.Step(RoadFrame(100.0 + 0.05 * k, 1.0 * k, false));
+  const LaneElement& lane = rig.store.lanes()[0];
+  const auto same = rig.tracker.RefitControlPoints(lane, TestCamera(), TestExtrinsic());
+  Eigen::Isometry3d lifted = TestExtrinsic();
+  lifted.translation().z() += 0.3;  // a higher camera puts ground points farther out
+  const auto wider = rig.tracker.RefitControlPoints(lane, TestCamera(), lifted);
+  ASSERT_GE(same.size(), 4u);
+  ASSERT_GE(wider.size(), 4u);
+  EXPECT_NEAR(same[1].y(), 1.8, 0.1);
+  EXPECT_GT(wider[1].y(), same[1].y() + 0.1);
+}
+
+}  // namespace
+}  // namespace ipm_road_mapper

@@ -1,0 +1,86 @@
+// The marking tracker alone, on observations extracted from rendered masks: a marking seen
+// again is one element with the running mean of its corners, a duplicate element of one
+// class at one place is merged (and one of another class is not), and an element seen once
+// is dropped after the spurious horizon.
+#include <gtest/gtest.h>
+
+#include "common/road_scene.h"
+#include "ipm_road_mapper/core/frontend/instance_extraction.h"
+#include "ipm_road_mapper/core/mapper/marking_tracker.h"
+
+namespace ipm_road_mapper {
+namespace {
+
+using namespace test;  // NOLINT: the scene's helpers
+
+struct Rig {
+  explicit Rig(MapperOptions o = MapperOptions()) : options(std::move(o)), store(4.0) {
+    options.association = EffectiveAssociationOptions(options);
+  }
+  // Extracts the frame's observations and runs the tracker on them.
+  void Step(const FrameInput& in) {
+    const Ipm ipm(PinholeCamera(in.camera), TestExtrinsic(), options.ipm.max_range_m);
+    FrameObservations obs = ExtractObservations(in.mask, classes, ipm, options.ipm.error_model,
+                                                options.extraction);
+    const FrameRecord& frame = store.AddFrame(in.stamp, in.T_map_base_odom);
+    tracker.Update(ipm, frame, &obs.markings);
+    tracker.DropSpurious(frame.index);
+  }
+  MapperOptions options;
+  ClassTable classes = TestClasses();
+  MapStore store;
+  MapperCounters counters;
+  MarkingTracker tracker{options, &store, &counters};
+};
+
+TEST(MarkingTracker, ReobservedMarkingIsOneElementWithTheMeanOfItsCorners) {
+  Rig rig;
+  for (int k = 0; k < 6; ++k) rig.Step(RoadFrame(100.0 + 0.05 * k, 0.5 * k));
+  ASSERT_EQ(rig.store.markings().size(), 1u);
+  const MarkingElement& arrow = rig.store.markings()[0];
+  EXPECT_EQ(arrow.history.size(), 6u);
+  EXPECT_EQ(arrow.first_frame, 0u);
+  EXPECT_EQ(arrow.last_frame, 5u);
+  EXPECT_NEAR(arrow.Center().x(), 21.5, 0.15);
+  EXPECT_NEAR(arrow.Center().y(), 0.0, 0.05);
+  EXPECT_EQ(rig.counters.markings_created, 1u);
+  EXPECT_FALSE(arrow.optimized);
+}
+
+TEST(MarkingTracker, DuplicatesOfOneClassMergeOthersDoNot) {
+  Rig rig;
+  rig.Step(RoadFrame(100.0, 0.0));
+  ASSERT_EQ(rig.store.markings().size(), 1u);
+  // A second element of the arrow's class 0.3 m beside it (a missed association), and one
+  // of another class at the same place.
+  MarkingElement copy = rig.store.markings()[0];
+  copy.id = rig.store.NewId();
+  for (Eigen::Vector3d& c : copy.corners_map) c.y() += 0.3;
+  copy.history[0].frame_index = 0;
+  MarkingElement other = copy;
+  other.id = rig.store.NewId();
+  other.class_id = 11;
+  rig.store.markings().push_back(copy);
+  rig.store.markings().push_back(other);
+  rig.Step(RoadFrame(100.05, 0.5));
+  ASSERT_EQ(rig.store.markings().size(), 2u);
+  EXPECT_EQ(rig.counters.markings_merged, 1u);
+  const MarkingElement& arrow = rig.store.markings()[0];
+  EXPECT_EQ(arrow.class_id, 10);
+  // One measurement per frame: frame 0's twice-held measurement kept once, plus frame 1's.
+  EXPECT_EQ(arrow.history.size(), 2u);
+}
+
+TEST(MarkingTracker, MarkingSeenOnceIsDroppedAfterTheHorizon) {
+  Rig rig;
+  rig.Step(RoadFrame(100.0, 0.0));
+  const int horizon = rig.options.association.spurious_after_frames;
+  for (int k = 1; k <= horizon; ++k) rig.Step(RoadFrame(100.0 + 0.05 * k, 0.0, false));
+  EXPECT_EQ(rig.store.markings().size(), 1u);  // not yet: exactly at the horizon
+  rig.Step(RoadFrame(100.0 + 0.05 * (horizon + 1), 0.0, false));
+  EXPECT_TRUE(rig.store.markings().empty());
+  EXPECT_EQ(rig.counters.spurious_dropped, 1u);
+}
+
+}  // namespace
+}  // namespace ipm_road_mapper
