@@ -24,7 +24,6 @@
 #include "ipm_road_mapper/core/backend/residuals/ppsr_residual.h"
 #include "ipm_road_mapper/core/backend/residuals/projection.h"
 #include "ipm_road_mapper/core/backend/residuals/psr_residual.h"
-#include "ipm_road_mapper/core/backend/residuals/translation_prior_residual.h"
 #include "ipm_road_mapper/core/geometry/rigid_transform.h"
 
 namespace ipm_road_mapper {
@@ -467,7 +466,7 @@ TEST_F(PsrTest, UsesTheFixedParameterNotTheClosestPoint) {
 }
 
 // ---------------------------------------------------------------------------------------
-// Translation prior.
+// Lane smoothness.
 
 TEST(LaneSmoothnessResidualTest, IsTheScaledSecondDifferenceAndPassesTheGradientCheck) {
   const Eigen::Vector3d c0(0, 0, 0), c1(3, 0.1, 0.0), c2(6, 0.3, 0.05);
@@ -479,23 +478,6 @@ TEST(LaneSmoothnessResidualTest, IsTheScaledSecondDifferenceAndPassesTheGradient
   // Evenly spaced points on a line cost nothing.
   const Eigen::Vector3d d2(6, 0.2, 0.0);
   EXPECT_LT(Evaluate(*cost, {c0.data(), c1.data(), d2.data()}).norm(), 1e-12);
-}
-
-TEST(TranslationPriorResidualTest, GradientCheck) {
-  const Eigen::Vector3d t0(1.5, 0.0, 1.5), t(1.6, -0.2, 1.45);
-  std::unique_ptr<ceres::CostFunction> cost(
-      TranslationPriorResidual::Create(t0, Eigen::Vector3d(0.05, 0.1, 0.02)));
-  ExpectJacobiansMatch(*cost, {nullptr}, {t.data()}, kGradientPrecision);
-}
-
-TEST(TranslationPriorResidualTest, IsZeroAtThePriorAndTheScaledOffsetPerAxis) {
-  const Eigen::Vector3d t0(1.5, 0.0, 1.5), sigma(0.05, 0.1, 0.02);
-  std::unique_ptr<ceres::CostFunction> cost(TranslationPriorResidual::Create(t0, sigma));
-  EXPECT_NEAR(Evaluate(*cost, {t0.data()}).norm(), 0.0, 1e-15);
-  const Eigen::Vector3d offset(0.1, -0.2, 0.03);
-  const Eigen::Vector3d t = t0 + offset;
-  const Eigen::VectorXd r = Evaluate(*cost, {t.data()});
-  for (int i = 0; i < 3; ++i) EXPECT_NEAR(r(i), offset(i) / sigma(i), 1e-12) << i;
 }
 
 // ---------------------------------------------------------------------------------------
@@ -734,9 +716,9 @@ TEST(ResidualSolveTest, CornersAndExtrinsicRotationRecoverThePitch) {
                                extrinsic.q.data(), extrinsic.t.data());
     }
   }
-  problem.AddResidualBlock(
-      TranslationPriorResidual::Create(T_true.translation(), Eigen::Vector3d::Constant(0.05)),
-      nullptr, extrinsic.t.data());
+  // The lever arm is not what this test recovers (one pass over flat ground barely observes
+  // it): it is held at its true value, the rotation is free.
+  problem.SetParameterBlockConstant(extrinsic.t.data());
   problem.SetManifold(extrinsic.q.data(), new ceres::EigenQuaternionManifold);
   for (PoseBlocks& pose : pose_blocks) {
     problem.SetParameterBlockConstant(pose.q.data());
@@ -826,19 +808,6 @@ TEST(ResidualSolveTest, PsrRecoversControlPoints) {
   std::cout << summary.BriefReport() << "\n";
   ASSERT_TRUE(summary.IsSolutionUsable());
   for (int i = 0; i < 6; ++i) EXPECT_LT((control[i] - control_true[i]).norm(), 1e-6) << i;
-}
-
-TEST(ResidualSolveTest, TranslationPriorPullsTheExtrinsicTranslation) {
-  const Eigen::Vector3d t0(1.5, 0.0, 1.5);
-  Eigen::Vector3d t(1.9, -0.3, 1.2);
-  ceres::Problem problem;
-  problem.AddResidualBlock(TranslationPriorResidual::Create(t0, Eigen::Vector3d(0.05, 0.1, 0.02)),
-                           nullptr, t.data());
-  ceres::Solver::Summary summary;
-  ceres::Solve(TightSolverOptions(), &problem, &summary);
-  std::cout << summary.BriefReport() << "\n";
-  ASSERT_TRUE(summary.IsSolutionUsable());
-  EXPECT_LT((t - t0).norm(), 1e-9);
 }
 
 TEST(ResidualSolveTest, PoseStepCorrectsOdometryWithMarkings) {
