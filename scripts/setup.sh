@@ -37,6 +37,13 @@ fi
 # --- 2. Build ----------------------------------------------------------------------------
 # catkin writes PYTHONPATH='' into its cached env unless this exists before configure.
 mkdir -p "$build/devel/lib/python3/dist-packages"
+# IRM_CMAKE_ARGS: extra CMake arguments, e.g. -DIRM_WARNINGS_AS_ERRORS=ON (scripts/test.sh
+# passes it when CI is set). On an existing build folder they are applied by re-running cmake.
+if [ -f "$build/CMakeCache.txt" ] && [ -n "${IRM_CMAKE_ARGS:-}" ]; then
+  log "re-configuring $build with: $IRM_CMAKE_ARGS"
+  cmake -S "$repo" -B "$build" ${IRM_CMAKE_ARGS} >"$build/configure.log" 2>&1 \
+    || { cat "$build/configure.log"; exit 1; }
+fi
 if [ ! -f "$build/CMakeCache.txt" ]; then
   log "configuring into $build"
   # ccache, when installed, makes a rebuild in a fresh build folder fast.

@@ -14,6 +14,7 @@
 #include <opencv2/core.hpp>
 #include <vector>
 
+#include "common/test_scene.h"
 #include "ipm_road_mapper/core/geometry/ipm.h"
 #include "ipm_road_mapper/core/geometry/pinhole_camera.h"
 
@@ -25,13 +26,7 @@ constexpr int kTestHeight = 720;
 
 // 1280x720, fx = fy = 1000, principal point at the image center, no distortion.
 inline PinholeCamera TestCamera() {
-  CameraIntrinsics in;
-  in.width = kTestWidth;
-  in.height = kTestHeight;
-  in.fx = in.fy = 1000.0;
-  in.cx = 640.0;
-  in.cy = 360.0;
-  return PinholeCamera(in);
+  return PinholeCamera(Intrinsics(kTestWidth, kTestHeight, 1000.0, 640.0, 360.0));
 }
 
 // Camera `height_m` above base_link's origin looking forward, pitched down by `pitch_deg`.

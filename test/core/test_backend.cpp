@@ -5,6 +5,7 @@
 
 #include <random>
 
+#include "common/test_scene.h"
 #include "ipm_road_mapper/core/backend/backend.h"
 #include "ipm_road_mapper/core/geometry/ipm.h"
 #include "ipm_road_mapper/core/geometry/rigid_transform.h"
@@ -14,30 +15,9 @@ namespace {
 
 constexpr double kDeg = M_PI / 180.0;
 
-CameraIntrinsics TestCamera() {
-  CameraIntrinsics c;
-  c.width = 1280;
-  c.height = 720;
-  c.fx = c.fy = 1000.0;
-  c.cx = 640.0;
-  c.cy = 360.0;
-  return c;
-}
-
+// The test camera 1.5 m ahead and 1.5 m up, pitched and yawed by the given degrees.
 Eigen::Isometry3d Extrinsic(double pitch_deg, double yaw_deg) {
-  Eigen::Matrix3d R_base_optical;
-  R_base_optical << 0, 0, 1, -1, 0, 0, 0, -1, 0;
-  Eigen::Isometry3d T = Eigen::Isometry3d::Identity();
-  T.linear() = RotationFromRpy(0.0, pitch_deg * kDeg, yaw_deg * kDeg) * R_base_optical;
-  T.translation() = Eigen::Vector3d(1.5, 0.0, 1.5);
-  return T;
-}
-
-Eigen::Isometry3d Pose(double x, double y, double yaw) {
-  Eigen::Isometry3d T = Eigen::Isometry3d::Identity();
-  T.linear() = RotationFromRpy(0, 0, yaw);
-  T.translation() = Eigen::Vector3d(x, y, 0);
-  return T;
+  return test::MountedCamera(0.0, pitch_deg * kDeg, yaw_deg * kDeg);
 }
 
 // A straight drive past markings at x = 20, 32, 44 m (alternating sides), 20 frames, with
@@ -55,21 +35,22 @@ Scene MakeScene(double pose_noise_m, unsigned seed) {
   Scene scene;
   std::mt19937 rng(seed);
   std::normal_distribution<double> noise(0.0, 1.0);
-  const PinholeCamera camera(TestCamera());
+  const PinholeCamera camera(test::Intrinsics1280x720());
   WindowSnapshot& s = scene.snapshot;
-  s.camera = TestCamera();
+  s.camera = test::Intrinsics1280x720();
   s.T_base_cam = Extrinsic(5.6, 0.4);  // 0.6 deg pitch, 0.4 deg yaw off
   // The mounting prior: loose on the angles around the rough value, whose translation is the
   // true one here.
   s.extrinsic_prior = ExtrinsicPrior(s.T_base_cam, Eigen::Vector3d::Constant(2.0 * kDeg),
                                      Eigen::Vector3d::Constant(0.02));
   for (int k = 0; k < 20; ++k) {
-    const Eigen::Isometry3d T_true = Pose(1.0 * k, 0.0, 0.002 * k);
+    const Eigen::Isometry3d T_true = test::PlanarPose(1.0 * k, 0.0, 0.002 * k);
     scene.poses_true.push_back(T_true);
     WindowFrame f;
     f.index = 100 + k;
-    f.T_map_base_odom = T_true * Pose(pose_noise_m * noise(rng), pose_noise_m * noise(rng),
-                                      0.1 * kDeg * pose_noise_m / 0.3 * noise(rng));
+    f.T_map_base_odom =
+        T_true * test::PlanarPose(pose_noise_m * noise(rng), pose_noise_m * noise(rng),
+                                  0.1 * kDeg * pose_noise_m / 0.3 * noise(rng));
     f.T_map_base = f.T_map_base_odom;
     s.frames.push_back(f);
   }

@@ -6,6 +6,7 @@
 
 #include <random>
 
+#include "common/test_scene.h"
 #include "ipm_road_mapper/core/backend/extrinsic_marginalization.h"
 #include "ipm_road_mapper/core/backend/extrinsic_prior.h"
 #include "ipm_road_mapper/core/backend/residuals/corner_reprojection_residual.h"
@@ -18,30 +19,15 @@ namespace {
 
 constexpr double kDeg = M_PI / 180.0;
 
-CameraIntrinsics Intrinsics() {
-  CameraIntrinsics c;
-  c.width = 1280;
-  c.height = 720;
-  c.fx = c.fy = 1000.0;
-  c.cx = 639.5;
-  c.cy = 359.5;
-  c.distortion = {-0.05, 0.01, 0.0, 0.0, 0.0};
-  return c;
-}
-
+// The test camera 1.5 m ahead and z up, pitched and rolled by the given degrees.
 Eigen::Isometry3d Extrinsic(double pitch_deg, double roll_deg, double z) {
-  Eigen::Matrix3d R_base_optical;
-  R_base_optical << 0, 0, 1, -1, 0, 0, 0, -1, 0;
-  Eigen::Isometry3d T = Eigen::Isometry3d::Identity();
-  T.linear() = RotationFromRpy(roll_deg * kDeg, pitch_deg * kDeg, 0.0) * R_base_optical;
-  T.translation() = Eigen::Vector3d(1.5, 0.0, z);
-  return T;
+  return test::MountedCamera(roll_deg * kDeg, pitch_deg * kDeg, 0.0, Eigen::Vector3d(1.5, 0.0, z));
 }
 
 // Markings (4 corners each, on the ground) seen from a vehicle driving along x on a gentle
 // curve, with 1 px noise; the rough extrinsic is 0.3 deg / 3 cm off.
 struct Scene {
-  PinholeCamera camera{Intrinsics()};
+  PinholeCamera camera{test::Intrinsics1280x720(639.5, 359.5, test::kMildDistortion)};
   Eigen::Isometry3d T_true = Extrinsic(4.0, 0.0, 1.5);
   Eigen::Isometry3d T_rough = Extrinsic(4.3, 0.2, 1.47);
   std::vector<Eigen::Isometry3d> poses;
@@ -55,11 +41,7 @@ struct Scene {
     std::mt19937 rng(5);
     std::normal_distribution<double> noise(0.0, 1.0);
     for (int k = 0; k < 60; ++k) {
-      Eigen::Isometry3d T = Eigen::Isometry3d::Identity();
-      const double yaw = 0.002 * k;
-      T.linear() = RotationFromRpy(0.0, 0.0, yaw);
-      T.translation() = Eigen::Vector3d(0.5 * k, 0.01 * k * k, 0.0);
-      poses.push_back(T);
+      poses.push_back(test::PlanarPose(0.5 * k, 0.01 * k * k, 0.002 * k));
     }
     for (int m = 0; m < 6; ++m) {
       const double x = 12.0 + 4.0 * m, y = (m % 3 - 1) * 2.5;

@@ -10,9 +10,9 @@
 #include <string>
 #include <vector>
 
-#include "ipm_road_mapper/core/frontend/instance_extraction.h"
 #include "../../src/core/frontend/instance_extraction_runs.h"  // BoundingRectangle
 #include "common/mask_test_utils.h"
+#include "ipm_road_mapper/core/frontend/instance_extraction.h"
 
 namespace ipm_road_mapper {
 namespace {
@@ -233,8 +233,7 @@ TEST_F(InstanceExtractionTest, SetMarkingRectangleReorientsAlongTheRoad) {
   const auto truth = GroundRectangle({12.0, 1.2}, 3.0, 0.8, yaw);
   EXPECT_GT(MaxCornerError(obs.markings[0], truth), 0.1);
   ASSERT_TRUE(SetMarkingRectangle(ipm_, IpmErrorModel(),
-                                  Eigen::Vector2d(std::cos(yaw), std::sin(yaw)),
-                                  &obs.markings[0]));
+                                  Eigen::Vector2d(std::cos(yaw), std::sin(yaw)), &obs.markings[0]));
   EXPECT_LT(MaxCornerError(obs.markings[0], truth), 0.06);  // a pixel is ~0.1 m deep at 12 m
   // The pixel corners follow.
   for (int i = 0; i < 4; ++i) {

@@ -7,6 +7,7 @@
 #include <ostream>
 #include <string>
 
+#include "common/test_scene.h"
 #include "ipm_road_mapper/core/geometry/ipm.h"
 #include "ipm_road_mapper/core/geometry/rigid_transform.h"
 
@@ -18,28 +19,6 @@ constexpr double kCameraHeight = 1.5;
 constexpr double kCameraAhead = 1.2;    // camera x in base_link
 constexpr double kCameraLateral = 0.1;  // camera y in base_link
 
-CameraIntrinsics MakeIntrinsics(bool distorted) {
-  CameraIntrinsics in;
-  in.width = 1280;
-  in.height = 720;
-  in.fx = 1000.0;
-  in.fy = 1012.5;
-  in.cx = 652.3;
-  in.cy = 351.7;
-  if (distorted) in.distortion = {-0.3, 0.1, 1e-3, -5e-4, -0.02};
-  return in;
-}
-
-// Rotation taking optical-frame vectors (x right, y down, z forward) into a body frame
-// (x forward, y left, z up).
-Eigen::Matrix3d RotationBodyOptical() {
-  Eigen::Matrix3d R;
-  R.col(0) = -Eigen::Vector3d::UnitY();  // optical x (right) = body -y
-  R.col(1) = -Eigen::Vector3d::UnitZ();  // optical y (down) = body -z
-  R.col(2) = Eigen::Vector3d::UnitX();   // optical z (forward) = body x
-  return R;
-}
-
 // True when the point is in front of the camera within normalized radius 1 (45 deg off
 // axis). The plumb_bob polynomial of the distorted cameras here folds back beyond a radius of
 // about 1.45; points past the fold project into the image but are not seen by a real lens.
@@ -50,10 +29,8 @@ bool WithinLensFov(const Ipm& ipm, const Eigen::Vector3d& p_base) {
 
 // A camera kCameraHeight above the ground, pitched down by `pitch` (rad), with roll/yaw.
 Eigen::Isometry3d MakeTBaseCam(double roll, double pitch, double yaw) {
-  Eigen::Isometry3d T = Eigen::Isometry3d::Identity();
-  T.linear() = RotationFromRpy(roll, pitch, yaw) * RotationBodyOptical();
-  T.translation() = Eigen::Vector3d(kCameraAhead, kCameraLateral, kCameraHeight);
-  return T;
+  return test::MountedCamera(roll, pitch, yaw,
+                             Eigen::Vector3d(kCameraAhead, kCameraLateral, kCameraHeight));
 }
 
 struct IpmCase {
@@ -68,8 +45,8 @@ class IpmRoundTrip : public ::testing::TestWithParam<IpmCase> {
  protected:
   Ipm MakeIpm(double max_range_m = 1000.0) const {
     const IpmCase& c = GetParam();
-    return Ipm(PinholeCamera(MakeIntrinsics(c.distorted)), MakeTBaseCam(c.roll, c.pitch, c.yaw),
-               max_range_m);
+    return Ipm(PinholeCamera(test::AsymmetricIntrinsics(c.distorted)),
+               MakeTBaseCam(c.roll, c.pitch, c.yaw), max_range_m);
   }
 };
 
@@ -149,7 +126,7 @@ INSTANTIATE_TEST_SUITE_P(
 // point d ahead of it on its centre column at v = cy + fy tan(atan(h / d) - theta).
 TEST(Ipm, MatchesClosedFormForPitchedCamera) {
   const double pitch = 3.0 * kDeg;
-  const CameraIntrinsics in = MakeIntrinsics(false);
+  const CameraIntrinsics in = test::AsymmetricIntrinsics(false);
   Eigen::Isometry3d T_base_cam = MakeTBaseCam(0.0, pitch, 0.0);
   T_base_cam.translation().y() = 0.0;
   const Ipm ipm(PinholeCamera(in), T_base_cam, 1000.0);
@@ -166,8 +143,8 @@ TEST(Ipm, MatchesClosedFormForPitchedCamera) {
 // Swapped axes or a flipped sign anywhere in the chain would break these.
 TEST(Ipm, LeftIsLeftOfCentreAndFartherIsHigher) {
   for (bool distorted : {false, true}) {
-    const Ipm ipm(PinholeCamera(MakeIntrinsics(distorted)), MakeTBaseCam(0.0, 4.0 * kDeg, 0.0),
-                  100.0);
+    const Ipm ipm(PinholeCamera(test::AsymmetricIntrinsics(distorted)),
+                  MakeTBaseCam(0.0, 4.0 * kDeg, 0.0), 100.0);
     const double cx = ipm.camera().intrinsics().cx;
     Eigen::Vector2d left, right, near, far;
     ASSERT_TRUE(ipm.BaseToPixel({10.0, kCameraLateral + 2.0, 0.0}, &left));
@@ -194,7 +171,7 @@ TEST(Ipm, LeftIsLeftOfCentreAndFartherIsHigher) {
 
 TEST(Ipm, PixelsAtOrAboveTheHorizonAreRejected) {
   const double pitch = 4.0 * kDeg;
-  const CameraIntrinsics in = MakeIntrinsics(false);
+  const CameraIntrinsics in = test::AsymmetricIntrinsics(false);
   const Ipm ipm(PinholeCamera(in), MakeTBaseCam(0.0, pitch, 0.0), 1e6);
   const double horizon_v = in.cy - in.fy * std::tan(pitch);  // ~280.9
   const Eigen::Vector3d sentinel(7.0, 8.0, 9.0);
@@ -213,7 +190,8 @@ TEST(Ipm, PixelsAtOrAboveTheHorizonAreRejected) {
 TEST(Ipm, GroundPointsBeyondMaxRangeFromBaseOriginAreRejected) {
   // The range is the horizontal distance from base_link's origin, not from the camera
   // (which is kCameraAhead in front of it).
-  const Ipm ipm(PinholeCamera(MakeIntrinsics(true)), MakeTBaseCam(0.0, 4.0 * kDeg, 0.0), 40.0);
+  const Ipm ipm(PinholeCamera(test::AsymmetricIntrinsics(true)), MakeTBaseCam(0.0, 4.0 * kDeg, 0.0),
+                40.0);
   struct Case {
     Eigen::Vector3d ground;
     IpmStatus expected;
@@ -239,7 +217,8 @@ TEST(Ipm, GroundPointsBeyondMaxRangeFromBaseOriginAreRejected) {
 }
 
 TEST(Ipm, BaseToPixelRejectsPointsBehindTheCamera) {
-  const Ipm ipm(PinholeCamera(MakeIntrinsics(false)), MakeTBaseCam(0.0, 4.0 * kDeg, 0.0), 40.0);
+  const Ipm ipm(PinholeCamera(test::AsymmetricIntrinsics(false)),
+                MakeTBaseCam(0.0, 4.0 * kDeg, 0.0), 40.0);
   Eigen::Vector2d uv;
   EXPECT_FALSE(ipm.BaseToPixel({-5.0, 0.0, 0.0}, &uv));
   EXPECT_FALSE(ipm.BaseToPixel({kCameraAhead, kCameraLateral, kCameraHeight}, &uv));
@@ -248,7 +227,7 @@ TEST(Ipm, BaseToPixelRejectsPointsBehindTheCamera) {
 
 TEST(Ipm, AccessorsAndStatusNames) {
   const Eigen::Isometry3d T = MakeTBaseCam(0.01, 0.05, -0.02);
-  const Ipm ipm(PinholeCamera(MakeIntrinsics(true)), T, 33.0);
+  const Ipm ipm(PinholeCamera(test::AsymmetricIntrinsics(true)), T, 33.0);
   EXPECT_TRUE(ipm.T_base_cam().isApprox(T, 0.0));
   EXPECT_EQ(ipm.max_range_m(), 33.0);
   EXPECT_EQ(ipm.camera().intrinsics().fx, 1000.0);

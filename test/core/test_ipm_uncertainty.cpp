@@ -11,6 +11,7 @@
 #include <string>
 #include <vector>
 
+#include "common/test_scene.h"
 #include "ipm_road_mapper/core/geometry/ipm.h"
 #include "ipm_road_mapper/core/geometry/ipm_uncertainty.h"
 #include "ipm_road_mapper/core/geometry/rigid_transform.h"
@@ -21,25 +22,9 @@ namespace {
 constexpr double kDeg = M_PI / 180.0;
 constexpr double kCameraHeight = 1.5;
 
-CameraIntrinsics MakeIntrinsics(bool distorted) {
-  CameraIntrinsics in;
-  in.width = 1280;
-  in.height = 720;
-  in.fx = 1000.0;
-  in.fy = 1012.5;
-  in.cx = 652.3;
-  in.cy = 351.7;
-  if (distorted) in.distortion = {-0.3, 0.1, 1e-3, -5e-4, -0.02};
-  return in;
-}
-
+// The test camera 1.2 m ahead, 0.1 m left and kCameraHeight up, turned by roll, pitch, yaw.
 Eigen::Isometry3d MakeTBaseCam(double roll, double pitch, double yaw) {
-  Eigen::Matrix3d R_body_optical;
-  R_body_optical << 0, 0, 1, -1, 0, 0, 0, -1, 0;
-  Eigen::Isometry3d T = Eigen::Isometry3d::Identity();
-  T.linear() = RotationFromRpy(roll, pitch, yaw) * R_body_optical;
-  T.translation() = Eigen::Vector3d(1.2, 0.1, kCameraHeight);
-  return T;
+  return test::MountedCamera(roll, pitch, yaw, Eigen::Vector3d(1.2, 0.1, kCameraHeight));
 }
 
 struct Setup {
@@ -84,7 +69,9 @@ NumericJacobians CentralDifferences(const PinholeCamera& camera, const Eigen::Is
 
 class IpmUncertaintyTest : public ::testing::TestWithParam<Setup> {
  protected:
-  PinholeCamera camera() const { return PinholeCamera(MakeIntrinsics(GetParam().distorted)); }
+  PinholeCamera camera() const {
+    return PinholeCamera(test::AsymmetricIntrinsics(GetParam().distorted));
+  }
   Eigen::Isometry3d T_base_cam() const {
     return MakeTBaseCam(GetParam().roll, GetParam().pitch, GetParam().yaw);
   }

@@ -4,6 +4,7 @@
 
 #include <cmath>
 
+#include "common/test_scene.h"
 #include "ipm_road_mapper/core/frontend/marking_measurement.h"
 #include "ipm_road_mapper/core/geometry/rigid_transform.h"
 
@@ -12,32 +13,14 @@ namespace {
 
 constexpr double kDeg = M_PI / 180.0;
 
-CameraIntrinsics Intrinsics() {
-  CameraIntrinsics c;
-  c.width = 1280;
-  c.height = 720;
-  c.fx = c.fy = 1000.0;
-  c.cx = 639.5;
-  c.cy = 359.5;
-  c.distortion = {-0.05, 0.01, 0.0, 0.0, 0.0};
-  return c;
-}
-
 // Camera 1.5 m above the map origin looking along +x, pitched down 4 deg.
-Eigen::Isometry3d CameraPose() {
-  Eigen::Matrix3d R_base_optical;
-  R_base_optical << 0, 0, 1, -1, 0, 0, 0, -1, 0;
-  Eigen::Isometry3d T = Eigen::Isometry3d::Identity();
-  T.linear() = RotationFromRpy(0.0, 4.0 * kDeg, 0.0) * R_base_optical;
-  T.translation() = Eigen::Vector3d(1.5, 0.0, 1.5);
-  return T;
-}
+Eigen::Isometry3d CameraPose() { return test::MountedCamera(0.0, 4.0 * kDeg, 0.0); }
 
 // A 4 x 0.5 m stripe centered 12 m ahead, 1 m left, turned 5 deg, on a road plane that
 // rises 1 deg ahead and 0.5 deg to the left, 8 cm above z = 0 at the stripe: what body pitch
 // and waves do to base_link's view of the road.
 struct Scene {
-  PinholeCamera camera{Intrinsics()};
+  PinholeCamera camera{test::Intrinsics1280x720(639.5, 359.5, test::kMildDistortion)};
   Eigen::Vector3d axis;
   Eigen::Isometry3d T_map_cam = CameraPose();
   RoadPlane plane;

@@ -8,9 +8,9 @@
 // optical frame is related to it by optical = (-y, -z, x). So
 //   T_vehicle_optical = T_vehicle_cam * T_cam_optical.
 //
-// base_link for the flat-ground IPM: DESIGN.md puts its origin on the road under the vehicle
-// reference point. The vehicle-frame origin is not on the road (README: the lane points 10-15
-// m ahead lie about 0.25-0.36 m below it), so the road height is estimated as the median
+// base_link for the flat-ground IPM: docs/design.md §2 puts its origin on the road under the
+// vehicle reference point. The vehicle-frame origin is not on the road (README: the lane points
+// 10-15 m ahead lie about 0.25-0.36 m below it), so the road height is estimated as the median
 // vehicle-frame z of the lane points 10-15 m ahead, and base_link = vehicle frame shifted
 // down to it (same axes). The figures for the alternative (the vehicle origin as ground, i.e.
 // the camera height of the extrinsic, 2.12 m) are printed for reference, not asserted.

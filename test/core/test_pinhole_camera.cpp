@@ -9,23 +9,11 @@
 #include <opencv2/core.hpp>
 #include <vector>
 
+#include "common/test_scene.h"
 #include "ipm_road_mapper/core/geometry/pinhole_camera.h"
 
 namespace ipm_road_mapper {
 namespace {
-
-// fx != fy and cx, cy off-centre so that swapping them cannot go unnoticed.
-CameraIntrinsics MakeIntrinsics(bool distorted) {
-  CameraIntrinsics in;
-  in.width = 1280;
-  in.height = 720;
-  in.fx = 1000.0;
-  in.fy = 1012.5;
-  in.cx = 652.3;
-  in.cy = 351.7;
-  if (distorted) in.distortion = {-0.3, 0.1, 1e-3, -5e-4, -0.02};
-  return in;
-}
 
 cv::Mat CvCameraMatrix(const CameraIntrinsics& in) {
   return (cv::Mat_<double>(3, 3) << in.fx, 0.0, in.cx, 0.0, in.fy, in.cy, 0.0, 0.0, 1.0);
@@ -65,7 +53,7 @@ std::vector<Eigen::Vector2d> GridPixels(const CameraIntrinsics& in) {
 class PinholeCameraVsOpenCv : public ::testing::TestWithParam<bool> {};
 
 TEST_P(PinholeCameraVsOpenCv, ProjectMatchesProjectPoints) {
-  const CameraIntrinsics in = MakeIntrinsics(GetParam());
+  const CameraIntrinsics in = test::AsymmetricIntrinsics(GetParam());
   const PinholeCamera camera(in);
   const std::vector<cv::Point3d> points = GridPoints();
   std::vector<cv::Point2d> expected;
@@ -85,7 +73,7 @@ TEST_P(PinholeCameraVsOpenCv, ProjectMatchesProjectPoints) {
 }
 
 TEST_P(PinholeCameraVsOpenCv, UndistortMatchesUndistortPointsAndInvertsProject) {
-  const CameraIntrinsics in = MakeIntrinsics(GetParam());
+  const CameraIntrinsics in = test::AsymmetricIntrinsics(GetParam());
   const PinholeCamera camera(in);
   const std::vector<Eigen::Vector2d> pixels = GridPixels(in);
   std::vector<cv::Point2d> cv_pixels;
@@ -117,7 +105,7 @@ INSTANTIATE_TEST_SUITE_P(DistortedAndUndistorted, PinholeCameraVsOpenCv,
 
 TEST(PinholeCamera, OpticalFrameAxes) {
   // Optical frame: x right, y down, z forward.
-  const PinholeCamera camera(MakeIntrinsics(false));
+  const PinholeCamera camera(test::AsymmetricIntrinsics(false));
   Eigen::Vector2d uv;
   ASSERT_TRUE(camera.Project(Eigen::Vector3d(0.0, 0.0, 10.0), &uv));
   EXPECT_NEAR(uv.x(), 652.3, 1e-12);
@@ -131,7 +119,7 @@ TEST(PinholeCamera, OpticalFrameAxes) {
 }
 
 TEST(PinholeCamera, RejectsPointsBehindOrTooCloseToTheCamera) {
-  const PinholeCamera camera(MakeIntrinsics(true));
+  const PinholeCamera camera(test::AsymmetricIntrinsics(true));
   const Eigen::Vector2d sentinel(-123.0, -456.0);
   for (double z : {-5.0, 0.0, 0.5 * PinholeCamera::kMinDepth}) {
     Eigen::Vector2d uv = sentinel;
@@ -143,7 +131,7 @@ TEST(PinholeCamera, RejectsPointsBehindOrTooCloseToTheCamera) {
 }
 
 TEST(PinholeCamera, ValidateCatchesBadIntrinsics) {
-  EXPECT_EQ(PinholeCamera(MakeIntrinsics(true)).Validate(), "");
+  EXPECT_EQ(PinholeCamera(test::AsymmetricIntrinsics(true)).Validate(), "");
   struct Case {
     const char* what;
     void (*mutate)(CameraIntrinsics*);
@@ -163,19 +151,19 @@ TEST(PinholeCamera, ValidateCatchesBadIntrinsics) {
        [](CameraIntrinsics* in) { in->distortion[4] = std::numeric_limits<double>::infinity(); }},
   };
   for (const Case& c : cases) {
-    CameraIntrinsics in = MakeIntrinsics(true);
+    CameraIntrinsics in = test::AsymmetricIntrinsics(true);
     c.mutate(&in);
     EXPECT_NE(PinholeCamera(in).Validate(), "") << c.what;
   }
 }
 
 TEST(PinholeCamera, KAndHasDistortionAndInImage) {
-  const PinholeCamera camera(MakeIntrinsics(false));
+  const PinholeCamera camera(test::AsymmetricIntrinsics(false));
   Eigen::Matrix3d K_expected;
   K_expected << 1000.0, 0.0, 652.3, 0.0, 1012.5, 351.7, 0.0, 0.0, 1.0;
   EXPECT_EQ(camera.K(), K_expected);
   EXPECT_FALSE(camera.HasDistortion());
-  CameraIntrinsics in = MakeIntrinsics(false);
+  CameraIntrinsics in = test::AsymmetricIntrinsics(false);
   in.distortion[3] = 1e-6;  // any single nonzero coefficient counts
   EXPECT_TRUE(PinholeCamera(in).HasDistortion());
 
@@ -189,7 +177,7 @@ TEST(PinholeCamera, KAndHasDistortionAndInImage) {
 
 // d UndistortToNormalized / d uv via ceres::Jet against central differences.
 TEST(PinholeCamera, UndistortJetDerivativeMatchesCentralDifferences) {
-  const PinholeCamera camera(MakeIntrinsics(true));
+  const PinholeCamera camera(test::AsymmetricIntrinsics(true));
   using Jet = ceres::Jet<double, 2>;
   for (const Eigen::Vector2d& uv :
        {Eigen::Vector2d(652.3, 351.7), Eigen::Vector2d(30.0, 20.0), Eigen::Vector2d(1200.0, 650.0),
@@ -234,7 +222,7 @@ TEST(PinholeCamera, UndistortJetDerivativeMatchesCentralDifferences) {
 }
 
 TEST(PinholeCamera, UndistortWithoutDistortionIsTheAffineInverse) {
-  const PinholeCamera camera(MakeIntrinsics(false));
+  const PinholeCamera camera(test::AsymmetricIntrinsics(false));
   const Eigen::Vector2d xy = camera.UndistortToNormalized(Eigen::Vector2d(752.3, 250.45));
   EXPECT_NEAR(xy.x(), 0.1, 1e-15);
   EXPECT_NEAR(xy.y(), -0.1, 1e-15);

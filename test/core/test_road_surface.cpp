@@ -5,6 +5,7 @@
 
 #include <cmath>
 
+#include "common/test_scene.h"
 #include "ipm_road_mapper/core/backend/residuals/pose_uncertainty.h"
 #include "ipm_road_mapper/core/geometry/rigid_transform.h"
 #include "ipm_road_mapper/core/geometry/road_surface.h"
@@ -58,18 +59,8 @@ TEST(RoadSurfaceNear, ExtrapolatesTheClosestFrameAheadAndHandlesNoPoses) {
 }
 
 TEST(PoseUncertaintyWhitening, IsThePixelSigmaForExactPosesAndWeakerOtherwise) {
-  CameraIntrinsics c;
-  c.width = 1280;
-  c.height = 720;
-  c.fx = c.fy = 1000.0;
-  c.cx = 639.5;
-  c.cy = 359.5;
-  const PinholeCamera camera(c);
-  Eigen::Matrix3d R_base_optical;
-  R_base_optical << 0, 0, 1, -1, 0, 0, 0, -1, 0;
-  Eigen::Isometry3d T_base_cam = Eigen::Isometry3d::Identity();
-  T_base_cam.linear() = RotationFromRpy(0.0, 4.0 * kDeg, 0.0) * R_base_optical;
-  T_base_cam.translation() = Eigen::Vector3d(1.5, 0.0, 1.5);
+  const PinholeCamera camera(test::Intrinsics1280x720(639.5, 359.5));
+  const Eigen::Isometry3d T_base_cam = test::MountedCamera(0.0, 4.0 * kDeg, 0.0);
   const Eigen::Isometry3d T_map_base = Eigen::Isometry3d::Identity();
   const Eigen::Vector3d near(8.0, 1.0, 0.0), far(25.0, 1.0, 0.0);
   const Eigen::Matrix2d exact = residuals::PoseUncertaintyWhitening(

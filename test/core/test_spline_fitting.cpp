@@ -71,12 +71,6 @@ std::pair<double, double> Coverage(const ArcLane& lane, const CatmullRomSpline& 
   return {std::min(a, b), std::max(a, b)};
 }
 
-// The control points ordered by increasing arc position on the true lane.
-std::vector<Eigen::Vector3d> InArcOrder(const ArcLane& lane, std::vector<Eigen::Vector3d> c) {
-  if (lane.ArcPosition(c[1]) > lane.ArcPosition(c[c.size() - 2])) std::reverse(c.begin(), c.end());
-  return c;
-}
-
 CatmullRomSpline Fit(const std::vector<Eigen::Vector3d>& points) {
   const auto control_points = EstimateControlPoints(points, SplineFitOptions());
   if (!control_points) throw std::runtime_error("no fit");
@@ -215,108 +209,6 @@ TEST(SplineFitting, SameInputGivesSameOutput) {
   ASSERT_TRUE(first && second);
   ASSERT_EQ(first->size(), second->size());
   for (size_t k = 0; k < first->size(); ++k) EXPECT_EQ((*first)[k], (*second)[k]);
-}
-
-TEST(SplineFitting, ExtendForwardKeepsTheStartAndReachesTheNewEnd) {
-  const ArcLane lane;
-  const SplineFitOptions options;
-  const auto fit =
-      EstimateControlPoints(NoisyPoints(lane, EvenPositions(0.0, 30.0, 0.1), 0.05, 11), options);
-  ASSERT_TRUE(fit);
-  const std::vector<Eigen::Vector3d> initial = InArcOrder(lane, *fit);
-  const std::vector<Eigen::Vector3d> more =
-      NoisyPoints(lane, EvenPositions(25.0, 60.0, 0.1), 0.05, 12);
-  for (bool reversed : {false, true}) {
-    std::vector<Eigen::Vector3d> given = initial;
-    if (reversed) std::reverse(given.begin(), given.end());
-    std::vector<Eigen::Vector3d> extended = ExtendControlPoints(given, more, options);
-    ASSERT_GT(extended.size(), given.size());
-    // Direction kept: the unchanged part is the prefix (forward) or the suffix (reversed):
-    // c_0..c_{n-3}, and the old end c_{n-2} too when its interval was a full spacing.
-    if (reversed) std::reverse(extended.begin(), extended.end());
-    const size_t n = initial.size();
-    const bool full_end = std::abs((initial[n - 2] - initial[n - 3]).norm() - 3.0) < 0.003;
-    for (size_t k = 0; k < (full_end ? n - 1 : n - 2); ++k) {
-      EXPECT_EQ(extended[k], initial[k]) << k;
-    }
-    ExpectChordSpacing(extended, 3.0);
-    const CatmullRomSpline spline(extended);
-    const double worst = MaxDeviation(lane, spline);
-    const auto [begin, end] = Coverage(lane, spline);
-    std::printf(
-        "extended 0-30 m by 25-60 m (reversed %d): max deviation %.4f m, covers "
-        "[%.3f, %.3f] m\n",
-        reversed, worst, begin, end);
-    EXPECT_LT(worst, 0.05);
-    EXPECT_GT(end, 60.0 - 0.05);
-    EXPECT_LT(end, 60.0 + 0.2);
-  }
-}
-
-TEST(SplineFitting, PointsBehindTheStartExtendTheStart) {
-  const ArcLane lane;
-  const SplineFitOptions options;
-  const auto fit =
-      EstimateControlPoints(NoisyPoints(lane, EvenPositions(30.0, 60.0, 0.1), 0.05, 13), options);
-  ASSERT_TRUE(fit);
-  // Ordered 30 -> 60 m, so the new points at 0..35 m lie behind the start.
-  const std::vector<Eigen::Vector3d> initial = InArcOrder(lane, *fit);
-  const std::vector<Eigen::Vector3d> extended = ExtendControlPoints(
-      initial, NoisyPoints(lane, EvenPositions(0.0, 35.0, 0.1), 0.05, 14), options);
-  ASSERT_GT(extended.size(), initial.size());
-  // The start phantom (and the start c_1 when it closed a remainder interval) is replaced; the
-  // rest is the unchanged suffix.
-  const int added = static_cast<int>(extended.size()) - static_cast<int>(initial.size());
-  const bool full_start = std::abs((initial[2] - initial[1]).norm() - 3.0) < 0.003;
-  for (size_t k = full_start ? 1 : 2; k < initial.size(); ++k) {
-    EXPECT_EQ(extended[k + added], initial[k]) << k;
-  }
-  EXPECT_LT(lane.ArcPosition(extended[1]), lane.ArcPosition(extended[extended.size() - 2]));
-  const CatmullRomSpline spline(extended);
-  const double worst = MaxDeviation(lane, spline);
-  const auto [begin, end] = Coverage(lane, spline);
-  std::printf("extended 30-60 m by 0-35 m: max deviation %.4f m, covers [%.3f, %.3f] m\n", worst,
-              begin, end);
-  EXPECT_LT(worst, 0.05);
-  EXPECT_LT(begin, 0.05);
-  EXPECT_GT(begin, -0.2);
-}
-
-TEST(SplineFitting, GrowingInBatchesKeepsAccuracyAndChordSpacing) {
-  ArcLane lane;
-  lane.radius = 60.0;
-  const SplineFitOptions options;
-  auto c =
-      EstimateControlPoints(NoisyPoints(lane, EvenPositions(0.0, 12.0, 0.1), 0.1, 17), options);
-  ASSERT_TRUE(c);
-  std::vector<Eigen::Vector3d> grown = InArcOrder(lane, *c);
-  for (int batch = 0; batch < 10; ++batch) {  // overlapping 14 m batches, 10 m apart
-    const double from = 8.0 + 10.0 * batch;
-    grown = ExtendControlPoints(
-        grown, NoisyPoints(lane, EvenPositions(from, from + 14.0, 0.1), 0.1, 18 + batch), options);
-  }
-  const CatmullRomSpline spline(grown);
-  const double worst = MaxDeviation(lane, spline);
-  const auto [begin, end] = Coverage(lane, spline);
-  std::printf(
-      "grown in 10 batches, R=60, noise 0.1 m: max deviation %.4f m, covers [%.3f, %.3f] "
-      "m\n",
-      worst, begin, end);
-  EXPECT_LT(worst, 0.06);
-  EXPECT_GT(end, 112.0 - 0.2);
-  ExpectChordSpacing(grown, 3.0);
-}
-
-TEST(SplineFitting, PointsBesideTheSplineDoNotChangeIt) {
-  const ArcLane lane;
-  const SplineFitOptions options;
-  const auto initial =
-      EstimateControlPoints(NoisyPoints(lane, EvenPositions(0.0, 30.0, 0.1), 0.05, 15), options);
-  ASSERT_TRUE(initial);
-  const std::vector<Eigen::Vector3d> beside =
-      NoisyPoints(lane, EvenPositions(3.0, 27.0, 0.1), 0.05, 16);
-  EXPECT_EQ(ExtendControlPoints(*initial, beside, options), *initial);
-  EXPECT_EQ(ExtendControlPoints(*initial, {}, options), *initial);
 }
 
 }  // namespace

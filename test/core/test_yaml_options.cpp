@@ -11,8 +11,8 @@
 #include <vector>
 
 #include "ipm_road_mapper/core/frontend/class_table.h"
-#include "ipm_road_mapper/core/mapper/mapper_options.h"
 #include "ipm_road_mapper/core/io/yaml_options.h"
+#include "ipm_road_mapper/core/mapper/mapper_options.h"
 
 namespace ipm_road_mapper {
 namespace {
@@ -248,7 +248,7 @@ TEST(MapperOptions, ShippedMapperYamlLoads) {
     const auto e = ipm["pixel_error_px"].as<std::vector<double>>();
     EXPECT_EQ(o.ipm.error_model.pixel_error_px, Eigen::Vector2d(e[0], e[1]));
   }
-  // Sanity: the file's values are the DESIGN.md ones, in radians inside the code.
+  // Sanity: the file's values are the docs/design.md §4 ones, in radians inside the code.
   EXPECT_GT(o.ipm.max_range_m, 0.0);
   EXPECT_LT(o.ipm.error_model.pitch_sigma_rad, 0.1);  // radians, not 0.3 "degrees"
   const std::string dump = ToString(o);

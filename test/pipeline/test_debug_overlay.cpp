@@ -5,9 +5,9 @@
 
 #include <opencv2/imgproc.hpp>
 
-#include "ipm_road_mapper/pipeline/debug_overlay.h"
-#include "ipm_road_mapper/core/geometry/ipm.h"
 #include "common/mask_test_utils.h"
+#include "ipm_road_mapper/core/geometry/ipm.h"
+#include "ipm_road_mapper/pipeline/debug_overlay.h"
 
 namespace ipm_road_mapper {
 namespace {

@@ -8,6 +8,7 @@
 #include <string>
 #include <vector>
 
+#include "common/test_scene.h"
 #include "ipm_road_mapper/pipeline/frame_assembler.h"
 
 namespace ipm_road_mapper {
@@ -29,15 +30,8 @@ StampedPose ScrewPoseAt(double stamp) {
   return {stamp, ExpSe3(stamp * xi)};
 }
 
-CameraIntrinsics SomeCamera() {
-  CameraIntrinsics camera;
-  camera.width = 64;
-  camera.height = 48;
-  camera.fx = camera.fy = 50.0;
-  camera.cx = 32.0;
-  camera.cy = 24.0;
-  return camera;
-}
+// A tiny 64x48 camera (the assembler only passes it through).
+CameraIntrinsics SomeCamera() { return test::Intrinsics(64, 48, 50.0, 32.0, 24.0); }
 
 cv::Mat SomeMask() { return cv::Mat(48, 64, CV_16UC1, cv::Scalar(0)); }
 

@@ -4,29 +4,16 @@
 // lagging but present odometry never triggers it; reset keeps mapping.
 #include <gtest/gtest.h>
 
+#include "common/test_scene.h"
 #include "ipm_road_mapper/pipeline/mapping_session.h"
 
 namespace ipm_road_mapper {
 namespace {
 
-CameraIntrinsics Camera() {
-  CameraIntrinsics c;
-  c.width = 640;
-  c.height = 480;
-  c.fx = c.fy = 500.0;
-  c.cx = 320.0;
-  c.cy = 240.0;
-  return c;
-}
+// A 640x480 camera.
+CameraIntrinsics Camera() { return test::Intrinsics(640, 480, 500.0, 320.0, 240.0); }
 
-Eigen::Isometry3d Extrinsic() {
-  Eigen::Matrix3d R;
-  R << 0, 0, 1, -1, 0, 0, 0, -1, 0;
-  Eigen::Isometry3d T = Eigen::Isometry3d::Identity();
-  T.linear() = RotationFromRpy(0.0, 5.0 * M_PI / 180.0, 0.0) * R;
-  T.translation() = Eigen::Vector3d(1.5, 0.0, 1.5);
-  return T;
-}
+Eigen::Isometry3d Extrinsic() { return test::MountedCamera(0.0, 5.0 * M_PI / 180.0, 0.0); }
 
 MapperOptions Options() {
   MapperOptions o;

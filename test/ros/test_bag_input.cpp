@@ -10,6 +10,7 @@
 #include <cstdio>
 #include <string>
 
+#include "common/test_scene.h"
 #include "ipm_road_mapper/ros/bag_input.h"
 #include "ipm_road_mapper/ros/msg_conversion.h"
 
@@ -43,12 +44,7 @@ class BagInputTest : public ::testing::Test {
                                                            "camera_link", "camera_optical"));
     bag.write("/tf_static", ros::Time(kT0), first);
     bag.write("/tf_static", ros::Time(kT0), second);
-    CameraIntrinsics intrinsics;
-    intrinsics.width = 640;
-    intrinsics.height = 480;
-    intrinsics.fx = intrinsics.fy = 500.0;
-    intrinsics.cx = 320.0;
-    intrinsics.cy = 240.0;
+    const CameraIntrinsics intrinsics = test::Intrinsics(640, 480, 500.0, 320.0, 240.0);
     for (int k = 0; k < 10; ++k) {
       sensor_msgs::CameraInfo info = IntrinsicsToCameraInfo(intrinsics);
       info.header.stamp = ros::Time(kT0) + ros::Duration(0.1 * k);

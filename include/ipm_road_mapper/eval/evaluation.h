@@ -1,4 +1,4 @@
-// Accuracy of an exported map against the ground truth of a drive (DESIGN.md §5): marking
+// Accuracy of an exported map against the ground truth of a drive (docs/design.md §5): marking
 // and lane APE, lane F1, extrinsic and IPM error, pose error, storage. The definitions and
 // the JSON keys are documented in docs/file_formats.md ("Metrics JSON").
 #pragma once

@@ -1,5 +1,5 @@
 // Turns the time-ordered streams of odometry poses and (stamp, mask, camera) frames into
-// FrameInputs whose odometry pose is interpolated at the mask stamp (DESIGN.md §2 "Time").
+// FrameInputs whose odometry pose is interpolated at the mask stamp (docs/design.md §2 "Time").
 // Shared by the offline runner (map_from_bag) and the nodelet, so that a map made offline
 // and one made live see the same frames with the same poses. No ROS, no I/O, not
 // thread-safe (the caller owns the locking).

@@ -30,7 +30,7 @@ std::string CheckBagTopics(const rosbag::Bag& bag,
 std::string LookupStaticTransform(const rosbag::Bag& bag, const std::string& parent_frame,
                                   const std::string& child_frame, Eigen::Isometry3d* T);
 
-// Every camera_info of a topic, indexed by stamp, to pair masks with (DESIGN.md §2: masks and
+// Every camera_info of a topic, indexed by stamp, to pair masks with (docs/design.md §2: masks and
 // camera_info share a stamp). Sync "exact" needs the identical stamp; "approximate" takes the
 // nearest camera_info within half a frame period (the median camera_info period).
 class CameraInfoTable {

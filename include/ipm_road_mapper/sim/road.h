@@ -1,6 +1,6 @@
 // Road model of a synthetic drive: a horizontal centerline of straights and circular arcs
 // parameterized by arc length s, and a non-planar surface height z(s, l) over it (l is the
-// lateral offset, left > 0). Frames follow DESIGN.md §2: map z up.
+// lateral offset, left > 0). Frames follow docs/design.md §2: map z up.
 #pragma once
 
 #include <Eigen/Core>

@@ -1,6 +1,7 @@
 #include "ipm_road_mapper/core/backend/backend_options.h"
 
 #include <cmath>
+#include <sstream>
 #include <vector>
 
 namespace ipm_road_mapper {
@@ -14,6 +15,25 @@ const char* ToString(LaneResidual residual) {
     default:
       return "none";
   }
+}
+
+const char* ToString(RobustKernel kernel) {
+  switch (kernel) {
+    case RobustKernel::kHuber:
+      return "huber";
+    case RobustKernel::kCauchy:
+      return "cauchy";
+    case RobustKernel::kNone:
+      return "none";
+  }
+  return "none";
+}
+
+std::optional<RobustKernel> ParseRobustKernel(const std::string& name) {
+  for (RobustKernel kernel : {RobustKernel::kHuber, RobustKernel::kCauchy, RobustKernel::kNone}) {
+    if (name == ToString(kernel)) return kernel;
+  }
+  return std::nullopt;
 }
 
 namespace {
@@ -60,9 +80,11 @@ BackendOptions LoadBackendOptions(OptionsReader reader) {
   reader.Read<int>("queue_size", &o.queue_size, CheckPositiveInt);
   reader.Read<double>("pixel_sigma_px", &o.pixel_sigma_px, CheckPositive);
   reader.Read<double>("psr_sigma_m", &o.psr_sigma_m, CheckPositive);
-  reader.Read<std::string>("robust_kernel", &o.robust_kernel, [](const std::string& v) {
-    return v == "huber" || v == "cauchy" || v == "none" ? "" : "must be huber, cauchy or none";
+  std::string robust_kernel = ToString(o.robust_kernel);
+  reader.Read<std::string>("robust_kernel", &robust_kernel, [](const std::string& v) {
+    return ParseRobustKernel(v) ? "" : "must be huber, cauchy or none";
   });
+  o.robust_kernel = *ParseRobustKernel(robust_kernel);
   reader.Read<double>("robust_scale", &o.robust_scale, CheckPositive);
   o.translation_prior_sigma_m =
       ReadTriple(&reader, "translation_prior_sigma_m", o.translation_prior_sigma_m, 1.0);
@@ -78,6 +100,8 @@ BackendOptions LoadBackendOptions(OptionsReader reader) {
   reader.Read<double>("max_extrinsic_change_m", &o.max_extrinsic_change_m, CheckPositive);
   reader.Read<int>("max_lane_points_per_observation", &o.max_lane_points_per_observation,
                    CheckPositiveInt);
+  reader.Read<double>("max_lane_pixel_distance_m", &o.max_lane_pixel_distance_m, CheckPositive);
+  reader.Read<double>("max_outside_image_px", &o.max_outside_image_px, CheckNonNegative);
   reader.Read<int>("max_measurements_per_marking", &o.max_measurements_per_marking,
                    [](const int& v) { return v >= 2 ? "" : "must be >= 2"; });
   reader.Read<double>("road_height_sigma_m", &o.road_height_sigma_m, CheckPositive);
@@ -97,6 +121,65 @@ BackendOptions LoadBackendOptions(OptionsReader reader) {
   reader.Read<int>("final_global_rounds", &o.final_global_rounds, CheckPositiveInt);
   reader.RejectUnknownKeys();
   return o;
+}
+
+namespace {
+
+// `[x, y, z]` of v / scale.
+std::string Triple(const Eigen::Vector3d& v, double scale) {
+  std::ostringstream s;
+  s << "[" << v.x() / scale << ", " << v.y() / scale << ", " << v.z() / scale << "]";
+  return s.str();
+}
+
+const char* Bool(bool value) { return value ? "true" : "false"; }
+
+}  // namespace
+
+std::string ToString(const BackendOptions& o) {
+  std::ostringstream s;
+  const char* k = "backend.";
+  s << k << "enabled: " << Bool(o.enabled) << "\n"
+    << k << "synchronous: " << Bool(o.synchronous) << "\n"
+    << k << "optimize_extrinsic: " << Bool(o.optimize_extrinsic) << "\n"
+    << k << "optimize_markings: " << Bool(o.optimize_markings) << "\n"
+    << k << "optimize_z: " << Bool(o.optimize_z) << "\n"
+    << k << "pose_update: " << Bool(o.pose_update) << "\n"
+    << k << "lane_residual: " << ToString(o.lane_residual) << "\n"
+    << k << "window_frames: " << o.window_frames << "\n"
+    << k << "solve_every_n_frames: " << o.solve_every_n_frames << "\n"
+    << k << "rounds: " << o.rounds << "\n"
+    << k << "max_iterations: " << o.max_iterations << "\n"
+    << k << "queue_size: " << o.queue_size << "\n"
+    << k << "pixel_sigma_px: " << o.pixel_sigma_px << "\n"
+    << k << "psr_sigma_m: " << o.psr_sigma_m << "\n"
+    << k << "robust_kernel: " << ToString(o.robust_kernel) << "\n"
+    << k << "robust_scale: " << o.robust_scale << "\n"
+    << k << "translation_prior_sigma_m: " << Triple(o.translation_prior_sigma_m, 1.0) << "\n"
+    << k << "rotation_prior_sigma_deg: " << Triple(o.rotation_prior_sigma_rad, kDegToRad) << "\n"
+    << k << "pose_prior_sigma_trans_m: " << Triple(o.pose_prior_sigma_trans_m, 1.0) << "\n"
+    << k << "pose_prior_sigma_rot_deg: " << Triple(o.pose_prior_sigma_rot_rad, kDegToRad) << "\n"
+    << k << "max_extrinsic_change_deg: " << o.max_extrinsic_change_rad / kDegToRad << "\n"
+    << k << "max_extrinsic_change_m: " << o.max_extrinsic_change_m << "\n"
+    << k << "max_lane_points_per_observation: " << o.max_lane_points_per_observation << "\n"
+    << k << "max_lane_pixel_distance_m: " << o.max_lane_pixel_distance_m << "\n"
+    << k << "max_outside_image_px: " << o.max_outside_image_px << "\n"
+    << k << "max_measurements_per_marking: " << o.max_measurements_per_marking << "\n"
+    << k << "road_height_sigma_m: " << o.road_height_sigma_m << "\n"
+    << k << "road_height_sigma_per_m: " << o.road_height_sigma_per_m << "\n"
+    << k << "road_plane_radius_m: " << o.road_plane_radius_m << "\n"
+    << k << "lane_anchor_along_sigma_m: " << o.lane_anchor_along_sigma_m << "\n"
+    << k << "lane_anchor_across_sigma_m: " << o.lane_anchor_across_sigma_m << "\n"
+    << k << "lane_smoothness_sigma_m: " << o.lane_smoothness_sigma_m << "\n"
+    << k << "map_step_pose_sigma_scale: " << o.map_step_pose_sigma_scale << "\n"
+    << k << "motion_prior: " << Bool(o.motion_prior) << "\n"
+    << k << "motion_sigma_acc_mps2: " << Triple(o.motion_sigma_acc_mps2, 1.0) << "\n"
+    << k << "motion_sigma_angular_acc_radps2: " << Triple(o.motion_sigma_angular_acc_radps2, 1.0)
+    << "\n"
+    << k << "final_global_solve: " << Bool(o.final_global_solve) << "\n"
+    << k << "final_global_max_frames: " << o.final_global_max_frames << "\n"
+    << k << "final_global_rounds: " << o.final_global_rounds << "\n";
+  return s.str();
 }
 
 }  // namespace ipm_road_mapper

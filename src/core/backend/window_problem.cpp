@@ -8,9 +8,6 @@
 #include <limits>
 #include <map>
 
-#include "ipm_road_mapper/core/geometry/catmull_rom_spline.h"
-#include "ipm_road_mapper/core/geometry/ipm.h"
-#include "ipm_road_mapper/core/frontend/marking_measurement.h"
 #include "ipm_road_mapper/core/backend/residuals/along_lane_anchor_residual.h"
 #include "ipm_road_mapper/core/backend/residuals/corner_reprojection_residual.h"
 #include "ipm_road_mapper/core/backend/residuals/extrinsic_prior_residual.h"
@@ -21,17 +18,14 @@
 #include "ipm_road_mapper/core/backend/residuals/ppsr_residual.h"
 #include "ipm_road_mapper/core/backend/residuals/psr_residual.h"
 #include "ipm_road_mapper/core/backend/residuals/road_surface_prior_residual.h"
+#include "ipm_road_mapper/core/frontend/marking_measurement.h"
+#include "ipm_road_mapper/core/geometry/catmull_rom_spline.h"
+#include "ipm_road_mapper/core/geometry/ipm.h"
 #include "ipm_road_mapper/core/geometry/rigid_transform.h"
 #include "ipm_road_mapper/core/geometry/road_surface.h"
 
 namespace ipm_road_mapper {
 namespace {
-
-// Lane pixels whose IPM point is farther than this from the spline are not used.
-constexpr double kMaxLanePixelDistanceM = 1.5;
-// A measurement whose projection at the start of a solve is farther than this outside the
-// image is an outlier of association or a point behind the camera: it is not added.
-constexpr double kMaxOutsideImagePx = 100.0;
 
 // A rigid transform as Ceres parameter blocks: quaternion (x, y, z, w) and translation.
 struct PoseBlocks {
@@ -92,16 +86,16 @@ struct WindowState {
   }
 };
 
-// True when p_map projects in front of the camera of `slot`, at most kMaxOutsideImagePx
-// outside the image.
+// True when p_map projects in front of the camera of `slot`, at most margin_px outside the
+// image (BackendOptions::max_outside_image_px).
 bool ProjectsNearImage(const PinholeCamera& camera, const WindowState& state, std::size_t slot,
-                       const Eigen::Vector3d& p_map) {
+                       const Eigen::Vector3d& p_map, double margin_px) {
   Eigen::Vector2d uv;
   if (!residuals::ProjectMapPoint(camera, state.frames[slot].q, state.frames[slot].t,
                                   state.extrinsic.q, state.extrinsic.t, p_map, &uv)) {
     return false;
   }
-  const double m = kMaxOutsideImagePx;
+  const double m = margin_px;
   return uv.x() > -m && uv.y() > -m && uv.x() < camera.intrinsics().width + m &&
          uv.y() < camera.intrinsics().height + m;
 }
@@ -145,7 +139,9 @@ void CollectCornerMeasurements(const WindowSnapshot& snapshot, const BackendOpti
         }
       }
       for (int c = 0; c < 4; ++c) {
-        if (!ProjectsNearImage(camera, *state, slot->second, corners[c])) continue;
+        if (!ProjectsNearImage(camera, *state, slot->second, corners[c],
+                               options.max_outside_image_px))
+          continue;
         state->corner_measurements.push_back({m, c, slot->second, corners_uv[c]});
       }
     }
@@ -178,11 +174,13 @@ void CollectLanePixels(const WindowSnapshot& snapshot, const BackendOptions& opt
         if (ipm.PixelToGround(point.uv, &p_base) != IpmStatus::kOk) continue;
         const Eigen::Vector3d p_map = T_map_base * p_base;
         const CatmullRomSpline::ClosestPoint closest = spline.FindClosest(p_map);
-        if (closest.distance_m > kMaxLanePixelDistanceM) continue;
+        if (closest.distance_m > options.max_lane_pixel_distance_m) continue;
         if (closest.s <= 0.0 || closest.s >= spline.NumSegments()) continue;  // past an end
         const auto& cps = lane.control_points_map;
-        if (!ProjectsNearImage(camera, *state, slot->second, cps[closest.segment + 1]) ||
-            !ProjectsNearImage(camera, *state, slot->second, cps[closest.segment + 2])) {
+        if (!ProjectsNearImage(camera, *state, slot->second, cps[closest.segment + 1],
+                               options.max_outside_image_px) ||
+            !ProjectsNearImage(camera, *state, slot->second, cps[closest.segment + 2],
+                               options.max_outside_image_px)) {
           continue;
         }
         state->lane_pixels.push_back(
@@ -193,8 +191,14 @@ void CollectLanePixels(const WindowSnapshot& snapshot, const BackendOptions& opt
 }
 
 ceres::LossFunction* MakeLoss(const BackendOptions& options) {
-  if (options.robust_kernel == "huber") return new ceres::HuberLoss(options.robust_scale);
-  if (options.robust_kernel == "cauchy") return new ceres::CauchyLoss(options.robust_scale);
+  switch (options.robust_kernel) {
+    case RobustKernel::kHuber:
+      return new ceres::HuberLoss(options.robust_scale);
+    case RobustKernel::kCauchy:
+      return new ceres::CauchyLoss(options.robust_scale);
+    case RobustKernel::kNone:
+      return nullptr;
+  }
   return nullptr;
 }
 

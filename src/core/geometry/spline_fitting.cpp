@@ -7,8 +7,6 @@
 #include <limits>
 #include <stdexcept>
 
-#include "ipm_road_mapper/core/geometry/catmull_rom_spline.h"
-
 namespace ipm_road_mapper {
 namespace {
 
@@ -27,20 +25,13 @@ constexpr double kTukeyCutoff = 4.685;
 constexpr double kMinNoiseSigmaM = 0.02;
 // Median of the distance to the curve of 2D isotropic Gaussian noise (Rayleigh) in sigmas.
 constexpr double kRayleighMedian = 1.1774;
-// An end interval within this fraction of the chord spacing counts as full (the chord of a
-// 3 m arc is shorter by 0.5 mm at R = 50 m).
-constexpr double kFullIntervalTolerance = 1e-3;
-// Spacing of the samples of the existing spline that anchor an extension to it.
-constexpr double kAnchorSpacingM = 0.25;
 
-// A smooth lane curve as a fine polyline, with the fit's per-point results.
+// A smooth lane curve as a fine polyline, with the extent of the fit's inliers.
 struct LaneCurve {
   std::vector<Eigen::Vector3d> nodes;
-  std::vector<double> arc;           // arc length at each node, arc[0] = 0
-  std::vector<double> point_arc;     // arc coordinate of each input point's projection
-  std::vector<double> point_weight;  // robust weight of each input point (0: outlier)
-  double begin = 0.0;                // arc coordinate of the first inlier
-  double end = 0.0;                  // arc coordinate of the last inlier
+  std::vector<double> arc;  // arc length at each node, arc[0] = 0
+  double begin = 0.0;       // arc coordinate of the first inlier
+  double end = 0.0;         // arc coordinate of the last inlier
 
   // Point at arc coordinate a; linear extrapolation along the end segments beyond the ends.
   Eigen::Vector3d At(double a) const {
@@ -50,18 +41,6 @@ struct LaneCurve {
     const double length = arc[k + 1] - arc[k];
     if (length <= 0.0) return nodes[k];
     return nodes[k] + (a - arc[k]) / length * (nodes[k + 1] - nodes[k]);
-  }
-
-  // Reverses the direction: arc coordinates become arc.back() - a.
-  void Reverse() {
-    const double total = arc.back();
-    std::reverse(nodes.begin(), nodes.end());
-    std::reverse(arc.begin(), arc.end());
-    for (double& a : arc) a = total - a;
-    for (double& a : point_arc) a = total - a;
-    std::swap(begin, end);
-    begin = total - begin;
-    end = total - end;
   }
 };
 
@@ -157,11 +136,9 @@ double Median(std::vector<double> values) {
 }
 
 // Steps 1-3 of the method: order, smooth, iterate with re-parameterization and re-weighting.
-// The first num_anchors points are exact (samples of an existing spline) and stay out of the
-// noise-scale estimate. Requires finite points; returns nullopt when the fit is degenerate or
-// too small.
+// Requires finite points; returns nullopt when the fit is degenerate or too small.
 std::optional<LaneCurve> FitLaneCurve(const std::vector<Eigen::Vector3d>& points,
-                                      const SplineFitOptions& options, size_t num_anchors = 0) {
+                                      const SplineFitOptions& options) {
   const size_t n = points.size();
   if (n < static_cast<size_t>(std::max(options.min_points, 3))) return std::nullopt;
   // Centering keeps the normal equations well scaled for map coordinates far from the origin.
@@ -204,10 +181,7 @@ std::optional<LaneCurve> FitLaneCurve(const std::vector<Eigen::Vector3d>& points
                                &residual[i]);
     }
     // Re-weight: Tukey's biweight of the distance to the curve, on a robust noise scale.
-    const double sigma = std::max(
-        kMinNoiseSigmaM,
-        Median(std::vector<double>(residual.begin() + std::min(num_anchors, n), residual.end())) /
-            kRayleighMedian);
+    const double sigma = std::max(kMinNoiseSigmaM, Median(residual) / kRayleighMedian);
     const double cutoff = kTukeyCutoff * sigma;
     for (size_t i = 0; i < n; ++i) {
       const double x = residual[i] / cutoff;
@@ -215,8 +189,6 @@ std::optional<LaneCurve> FitLaneCurve(const std::vector<Eigen::Vector3d>& points
     }
   }
   for (Eigen::Vector3d& node : curve.nodes) node += centroid;
-  curve.point_arc = t;
-  curve.point_weight = w;
   curve.begin = std::numeric_limits<double>::infinity();
   curve.end = -curve.begin;
   int inliers = 0;
@@ -265,6 +237,7 @@ std::vector<Eigen::Vector3d> WithPhantoms(const std::vector<Eigen::Vector3d>& on
   return control_points;
 }
 
+// The finite points of `points`, in their order.
 std::vector<Eigen::Vector3d> FinitePoints(const std::vector<Eigen::Vector3d>& points) {
   std::vector<Eigen::Vector3d> finite;
   finite.reserve(points.size());
@@ -274,70 +247,7 @@ std::vector<Eigen::Vector3d> FinitePoints(const std::vector<Eigen::Vector3d>& po
   return finite;
 }
 
-// Grows the spline at its last end (see ExtendControlPoints). The fit runs on the new points
-// beyond the end plus samples of the existing spline's last few smoothing lengths, which tie
-// the new part to the old one in position and direction. Control points c_0..c_{n-3} are kept;
-// the end c_{n-2} too unless it closes a remainder interval; the end phantom is replaced.
-std::vector<Eigen::Vector3d> ExtendAtEnd(const std::vector<Eigen::Vector3d>& control_points,
-                                         const std::vector<Eigen::Vector3d>& new_points,
-                                         const SplineFitOptions& options) {
-  const CatmullRomSpline spline(control_points);
-  const size_t n = control_points.size();
-  const Eigen::Vector3d end = control_points[n - 2];
-  Eigen::Vector3d direction = spline.Derivative(spline.NumSegments());
-  if (direction.norm() < 1e-9) direction = end - control_points[n - 3];
-  if (direction.norm() < 1e-9) return control_points;
-  direction.normalize();
-
-  std::vector<Eigen::Vector3d> fit_points;
-  // Anchors reach back past c_{n-3}, whose projection may start the new control points.
-  const double anchor_length = std::min(
-      spline.Length(), std::max(3.0 * options.smoothing_length_m, 2.0 * options.chord_spacing_m));
-  for (double a = spline.Length() - anchor_length; a <= spline.Length(); a += kAnchorSpacingM) {
-    fit_points.push_back(spline.Evaluate(spline.ParameterAtArcLength(a)));
-  }
-  const size_t num_anchors = fit_points.size();
-  for (const Eigen::Vector3d& p : new_points) {
-    if ((p - end).dot(direction) > 0.0) fit_points.push_back(p);
-  }
-  if (fit_points.size() - num_anchors < static_cast<size_t>(options.min_points)) {
-    return control_points;
-  }
-  std::optional<LaneCurve> curve = FitLaneCurve(fit_points, options, num_anchors);
-  if (!curve) return control_points;
-  if ((curve->At(curve->end) - curve->At(curve->begin)).dot(direction) < 0.0) curve->Reverse();
-
-  // The new control points continue from the old end, or from the one before it when the old
-  // end closes a remainder interval (not a full spacing): that end is then re-placed.
-  const int nodes_end = static_cast<int>(curve->nodes.size());
-  double distance = 0.0;
-  const double old_end = ProjectOnPolyline(curve->nodes, curve->arc, end, 0, nodes_end, &distance);
-  const bool replace_end =
-      std::abs((end - control_points[n - 3]).norm() - options.chord_spacing_m) >
-      kFullIntervalTolerance * options.chord_spacing_m;
-  const size_t kept = replace_end ? n - 2 : n - 1;  // control points kept, phantom included
-  const double from = replace_end
-                          ? ProjectOnPolyline(curve->nodes, curve->arc, control_points[n - 3], 0,
-                                              nodes_end, &distance)
-                          : old_end;
-  double to = old_end;
-  int beyond_inliers = 0;
-  for (size_t i = num_anchors; i < fit_points.size(); ++i) {
-    if (curve->point_weight[i] <= 0.0) continue;
-    ++beyond_inliers;
-    to = std::max(to, curve->point_arc[i]);
-  }
-  if (beyond_inliers < options.min_points || to - old_end < options.min_extent_m || !(to > from)) {
-    return control_points;
-  }
-  std::vector<Eigen::Vector3d> on_curve(control_points.begin() + 1, control_points.begin() + kept);
-  const std::vector<Eigen::Vector3d> added = PlaceAlong(*curve, from, to, options.chord_spacing_m);
-  on_curve.insert(on_curve.end(), added.begin() + 1, added.end());  // added[0]: the kept point
-  std::vector<Eigen::Vector3d> result = WithPhantoms(on_curve);
-  result.front() = control_points.front();  // the other end's phantom stays as it was
-  return result;
-}
-
+// Throws std::invalid_argument on options the fit cannot run with.
 void CheckOptions(const SplineFitOptions& options) {
   if (!(options.chord_spacing_m > 0.0) || !(options.smoothing_length_m > 0.0) ||
       !(options.min_extent_m >= 0.0)) {
@@ -355,21 +265,6 @@ std::optional<std::vector<Eigen::Vector3d>> EstimateControlPoints(
   const std::optional<LaneCurve> curve = FitLaneCurve(FinitePoints(points), options);
   if (!curve) return std::nullopt;
   return WithPhantoms(PlaceAlong(*curve, curve->begin, curve->end, options.chord_spacing_m));
-}
-
-std::vector<Eigen::Vector3d> ExtendControlPoints(const std::vector<Eigen::Vector3d>& control_points,
-                                                 const std::vector<Eigen::Vector3d>& new_points,
-                                                 const SplineFitOptions& options) {
-  CheckOptions(options);
-  if (control_points.size() < 4) {
-    throw std::invalid_argument("ExtendControlPoints needs at least 4 control points");
-  }
-  const std::vector<Eigen::Vector3d> finite = FinitePoints(new_points);
-  std::vector<Eigen::Vector3d> result = ExtendAtEnd(control_points, finite, options);
-  std::reverse(result.begin(), result.end());
-  result = ExtendAtEnd(result, finite, options);
-  std::reverse(result.begin(), result.end());
-  return result;
 }
 
 }  // namespace ipm_road_mapper

@@ -1,4 +1,4 @@
-// The back end's owned optimizer thread (DESIGN.md §3): the front end submits window
+// The back end's owned optimizer thread (docs/design.md §3): the front end submits window
 // snapshots through a bounded queue and never blocks on the optimizer; the optimizer
 // publishes immutable results that the front end takes when it is ready. Started in the
 // constructor, stopped in Stop()/the destructor by flag + notify + join; never detached,

@@ -4,6 +4,7 @@
 #pragma once
 
 #include <Eigen/Core>
+#include <optional>
 #include <string>
 
 #include "ipm_road_mapper/core/io/yaml_options.h"
@@ -17,8 +18,23 @@ enum class LaneResidual {
   kPpsr,  // projected point-to-spline residual on pixels (the paper's method)
 };
 
+// The config string of a lane residual: "none", "psr" or "ppsr".
 const char* ToString(LaneResidual residual);
 
+// The robust kernel on the measurement residuals (corners, PPSR, PSR).
+enum class RobustKernel {
+  kHuber,   // ceres::HuberLoss
+  kCauchy,  // ceres::CauchyLoss
+  kNone,    // plain least squares
+};
+
+// The config string of a robust kernel: "huber", "cauchy" or "none".
+const char* ToString(RobustKernel kernel);
+
+// The kernel named by `name` ("huber", "cauchy", "none"); nullopt for any other string.
+std::optional<RobustKernel> ParseRobustKernel(const std::string& name);
+
+// Every option of the back end, with its default.
 struct BackendOptions {
   bool enabled = true;             // false: plain IPM front end only
   bool synchronous = false;        // solve in the caller's thread (offline determinism)
@@ -27,15 +43,15 @@ struct BackendOptions {
   bool optimize_z = true;          // z of corners and control points free
   bool pose_update = true;         // run the pose-update step
   LaneResidual lane_residual = LaneResidual::kPpsr;
-  int window_frames = 40;               // frames whose observations enter a solve
-  int solve_every_n_frames = 5;         // how often the front end hands a window over
-  int rounds = 2;                       // map+extrinsic <-> pose alternations per solve
-  int max_iterations = 10;              // Ceres iterations per step
-  int queue_size = 2;                   // windows waiting for the optimizer thread
-  double pixel_sigma_px = 2.0;          // corner and PPSR measurement sigma
-  double psr_sigma_m = 0.2;             // PSR (3D) measurement sigma
-  std::string robust_kernel = "huber";  // huber, cauchy or none
-  double robust_scale = 2.0;            // kernel scale in whitened units (sigmas)
+  int window_frames = 40;        // frames whose observations enter a solve
+  int solve_every_n_frames = 5;  // how often the front end hands a window over
+  int rounds = 2;                // map+extrinsic <-> pose alternations per solve
+  int max_iterations = 10;       // Ceres iterations per step
+  int queue_size = 2;            // windows waiting for the optimizer thread
+  double pixel_sigma_px = 2.0;   // corner and PPSR measurement sigma
+  double psr_sigma_m = 0.2;      // PSR (3D) measurement sigma
+  RobustKernel robust_kernel = RobustKernel::kHuber;
+  double robust_scale = 2.0;  // kernel scale in whitened units (sigmas)
   Eigen::Vector3d translation_prior_sigma_m{0.02, 0.02, 0.02};
   // Prior of the extrinsic rotation on its rough value, per base_link axis (roll, pitch,
   // yaw): roll is unobservable on straight roads, pitch and yaw are observable.
@@ -46,7 +62,12 @@ struct BackendOptions {
   double max_extrinsic_change_rad = 2.0 * M_PI / 180.0;            // trust bound per solve
   double max_extrinsic_change_m = 0.2;
   int max_lane_points_per_observation = 6;  // PPSR/PSR pixels per lane observation
-  int max_measurements_per_marking = 10;    // observations of a marking per solve (spread)
+  // A lane pixel whose IPM point is farther than this from its spline is not used.
+  double max_lane_pixel_distance_m = 1.5;
+  // A measurement whose projection at the start of a solve is farther than this outside the
+  // image (an association outlier, or a point behind the camera) is not added.
+  double max_outside_image_px = 100.0;
+  int max_measurements_per_marking = 10;  // observations of a marking per solve (spread)
   // Road-surface prior of free map points (with optimize_z): the height of a point in
   // base_link of the window frame horizontally closest to it is ~0, with sigma
   // hypot(road_height_sigma_m, road_height_sigma_per_m * distance). base_link's origin is on
@@ -83,5 +104,9 @@ struct BackendOptions {
 
 // Reads the `backend` section; throws OptionsError naming the bad key.
 BackendOptions LoadBackendOptions(OptionsReader reader);
+
+// The options as `backend.<key>: <value>` lines, in config units (degrees), for the start-up
+// dump.
+std::string ToString(const BackendOptions& options);
 
 }  // namespace ipm_road_mapper

@@ -1,4 +1,4 @@
-// One solve of the back end over a sliding window (DESIGN.md §4, paper "Map Optimization"
+// One solve of the back end over a sliding window (docs/design.md §4, paper "Map Optimization"
 // and "Pose Update"): a copied snapshot of the window goes in, the optimized state comes
 // out; the live map is never touched here. Each round alternates
 //   1. map + extrinsic step: marking corners, lane control points, R_base_cam, t_base_cam

@@ -10,7 +10,7 @@
 
 namespace ipm_road_mapper {
 
-// How a class is mapped (DESIGN.md §1).
+// How a class is mapped (docs/design.md §1).
 enum class ElementKind { kLane, kMarking };
 
 // Lane line style, where known.

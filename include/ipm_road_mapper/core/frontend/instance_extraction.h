@@ -1,5 +1,5 @@
 // Instance extraction: 16UC1 instance mask -> marking rectangles and lane centerline points
-// on the ground of base_link (DESIGN.md §2 encoding, §4 markings).
+// on the ground of base_link (docs/design.md §2 encoding, §4 markings).
 #pragma once
 
 #include <opencv2/core.hpp>

@@ -1,6 +1,6 @@
 // IPM uncertainty (the paper's Omega_p) and point selection (PS).
 //
-// The ground point of a pixel is p = f(uv, theta, h): the IPM of DESIGN.md with the camera
+// The ground point of a pixel is p = f(uv, theta, h): the IPM of docs/design.md §4 with the camera
 // pitched by theta about base_link's y axis (about the camera center) and raised by h.
 // Three error sources propagate to first order:
 //   Omega_p = J_uv e_p e_p^T J_uv^T + sigma_theta^2 J_theta J_theta^T + sigma_h^2 J_h J_h^T
@@ -19,7 +19,7 @@
 
 namespace ipm_road_mapper {
 
-// Error model of one IPM measurement (DESIGN.md defaults: 2 px, 0.3 deg, 0.05 m).
+// Error model of one IPM measurement (docs/design.md §4 defaults: 2 px, 0.3 deg, 0.05 m).
 struct IpmErrorModel {
   Eigen::Vector2d pixel_error_px{2.0, 2.0};     // e_p, the segmentation error vector (u, v)
   double pitch_sigma_rad = 0.3 * M_PI / 180.0;  // sigma_theta: camera pitch vs the road

@@ -1,5 +1,5 @@
 // Growing a lane's spline as the vehicle drives: the ends of the control-point estimator g
-// ("extend the ends as new points arrive", DESIGN.md §4). g (spline_fitting.h) starts a lane
+// ("extend the ends as new points arrive", docs/design.md §4). g (spline_fitting.h) starts a lane
 // from one observation; every later frame hands the points of the lane's recent
 // observations to FitLaneEnds, which
 //  1. extends an end by whole chord spacings when enough points lie beyond it (along the

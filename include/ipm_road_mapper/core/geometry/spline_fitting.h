@@ -1,6 +1,6 @@
 // The control-point estimator g of the paper (g(tau(P))): from an unordered, noisy 3D point set
-// of one lane line to Catmull-Rom control points at a fixed chord spacing, plus growing an
-// existing lane as new points arrive.
+// of one lane line to Catmull-Rom control points at a fixed chord spacing. (A lane's ends are
+// grown as new points arrive by FitLaneEnds, lane_end_fit.h.)
 //
 // Method (details in spline_fitting.cpp):
 //  1. Order: project the points on their principal axis in x-y (PCA); this is the first
@@ -17,11 +17,11 @@
 //     interval), and add phantom end points by linear extrapolation, c_0 = 2 c_1 - c_2.
 //
 // One call must see a lane turning by less than ~150 degrees (the PCA order must not fold);
-// longer turns are grown piecewise with ExtendControlPoints.
+// longer lanes are grown at their ends with FitLaneEnds.
 //
 // Direction convention: EstimateControlPoints orders control points by increasing projection
 // on the principal axis, whose sign is chosen so that its x component is positive (its y
-// component when x is 0). ExtendControlPoints keeps the order it is given.
+// component when x is 0).
 #pragma once
 
 #include <Eigen/Core>
@@ -41,20 +41,9 @@ struct SplineFitOptions {
 // g: unordered noisy 3D lane points -> control points at chord spacing. The returned spline
 // (phantom end control points included) covers the points' full extent along the lane.
 // Non-finite points are ignored. Returns nullopt when fewer than min_points (inlier) points or
-// an extent below min_extent_m remain. Deterministic for a given input. Both functions throw
+// an extent below min_extent_m remain. Deterministic for a given input. Throws
 // std::invalid_argument unless chord_spacing_m > 0, smoothing_length_m > 0, min_extent_m >= 0.
 std::optional<std::vector<Eigen::Vector3d>> EstimateControlPoints(
     const std::vector<Eigen::Vector3d>& points, const SplineFitOptions& options);
-
-// Grows an existing spline: points of new_points lying beyond either end (along the end tangent)
-// add control points at chord spacing there; interior control points are left unchanged; points
-// beside the existing extent are ignored. Keeps the control-point order (direction) of the input.
-// At a grown end, the phantom is replaced and so is the end point when it closed a remainder
-// interval (not a full chord spacing), so that intervals stay at chord spacing; the rest is kept
-// bit for bit. An end grows only when at least min_points new inliers extend it by at least
-// min_extent_m. Throws std::invalid_argument when control_points has fewer than 4 points.
-std::vector<Eigen::Vector3d> ExtendControlPoints(const std::vector<Eigen::Vector3d>& control_points,
-                                                 const std::vector<Eigen::Vector3d>& new_points,
-                                                 const SplineFitOptions& options);
 
 }  // namespace ipm_road_mapper

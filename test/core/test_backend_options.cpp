@@ -1,0 +1,108 @@
+// Tests of the back-end options: the robust kernel enum and its parse, the tuning knobs
+// that were file-scope constants (same defaults, validated), the options dump, and the
+// shipped config/mapper.yaml's backend section.
+#include <gtest/gtest.h>
+#include <yaml-cpp/yaml.h>
+
+#include <functional>
+#include <string>
+
+#include "ipm_road_mapper/core/backend/backend_options.h"
+#include "ipm_road_mapper/core/io/yaml_options.h"
+
+namespace ipm_road_mapper {
+namespace {
+
+const std::string kMapperYaml = std::string(IRM_SOURCE_DIR) + "/config/mapper.yaml";
+
+BackendOptions LoadFrom(const std::string& yaml) {
+  return LoadBackendOptions(OptionsReader(YAML::Load(yaml), "backend"));
+}
+
+// The message of the OptionsError thrown by `f` ("" and a test failure when none is thrown).
+std::string ErrorOf(const std::function<void()>& f) {
+  try {
+    f();
+  } catch (const OptionsError& e) {
+    return e.what();
+  } catch (const std::exception& e) {
+    ADD_FAILURE() << "expected OptionsError, got another exception: " << e.what();
+    return e.what();
+  }
+  ADD_FAILURE() << "expected OptionsError, nothing was thrown";
+  return "";
+}
+
+TEST(RobustKernel, ParsesEveryConfigStringAndRoundTrips) {
+  EXPECT_EQ(ParseRobustKernel("huber"), RobustKernel::kHuber);
+  EXPECT_EQ(ParseRobustKernel("cauchy"), RobustKernel::kCauchy);
+  EXPECT_EQ(ParseRobustKernel("none"), RobustKernel::kNone);
+  for (RobustKernel kernel : {RobustKernel::kHuber, RobustKernel::kCauchy, RobustKernel::kNone}) {
+    EXPECT_EQ(ParseRobustKernel(ToString(kernel)), kernel) << ToString(kernel);
+  }
+}
+
+TEST(RobustKernel, RejectsOtherStrings) {
+  EXPECT_FALSE(ParseRobustKernel("Huber"));
+  EXPECT_FALSE(ParseRobustKernel("tukey"));
+  EXPECT_FALSE(ParseRobustKernel(""));
+}
+
+TEST(BackendOptions, RobustKernelIsReadFromItsString) {
+  EXPECT_EQ(LoadFrom("{}").robust_kernel, RobustKernel::kHuber);  // the default
+  EXPECT_EQ(LoadFrom("{robust_kernel: huber}").robust_kernel, RobustKernel::kHuber);
+  EXPECT_EQ(LoadFrom("{robust_kernel: cauchy}").robust_kernel, RobustKernel::kCauchy);
+  EXPECT_EQ(LoadFrom("{robust_kernel: none}").robust_kernel, RobustKernel::kNone);
+}
+
+TEST(BackendOptions, BadRobustKernelIsAnOptionsErrorNamingTheKey) {
+  EXPECT_EQ(ErrorOf([] { LoadFrom("{robust_kernel: tukey}"); }),
+            "backend.robust_kernel: must be huber, cauchy or none");
+  EXPECT_EQ(ErrorOf([] {
+              LoadFrom("{robust_kernel: [huber]}");
+            }).rfind("backend.robust_kernel: wrong type", 0),
+            0u);
+}
+
+TEST(BackendOptions, GatesKeepTheirFormerDefaults) {
+  const BackendOptions o = LoadFrom("{}");
+  EXPECT_EQ(o.max_lane_pixel_distance_m, 1.5);
+  EXPECT_EQ(o.max_outside_image_px, 100.0);
+}
+
+TEST(BackendOptions, GatesAreReadAndValidated) {
+  const BackendOptions o = LoadFrom("{max_lane_pixel_distance_m: 0.8, max_outside_image_px: 0}");
+  EXPECT_EQ(o.max_lane_pixel_distance_m, 0.8);
+  EXPECT_EQ(o.max_outside_image_px, 0.0);
+  EXPECT_EQ(ErrorOf([] {
+              LoadFrom("{max_lane_pixel_distance_m: 0}");
+            }).rfind("backend.max_lane_pixel_distance_m: ", 0),
+            0u);
+  EXPECT_EQ(ErrorOf([] {
+              LoadFrom("{max_outside_image_px: -1}");
+            }).rfind("backend.max_outside_image_px: ", 0),
+            0u);
+}
+
+TEST(BackendOptions, DumpListsTheKernelAndTheGates) {
+  BackendOptions o;
+  o.robust_kernel = RobustKernel::kCauchy;
+  o.max_lane_pixel_distance_m = 0.75;
+  const std::string dump = ToString(o);
+  EXPECT_NE(dump.find("backend.robust_kernel: cauchy\n"), std::string::npos) << dump;
+  EXPECT_NE(dump.find("backend.max_lane_pixel_distance_m: 0.75\n"), std::string::npos) << dump;
+  EXPECT_NE(dump.find("backend.max_outside_image_px: 100\n"), std::string::npos) << dump;
+}
+
+TEST(BackendOptions, ShippedMapperYamlKeepsTheDefaults) {
+  const YAML::Node backend = YAML::LoadFile(kMapperYaml)["backend"];
+  ASSERT_TRUE(backend.IsMap());
+  const BackendOptions o = LoadBackendOptions(OptionsReader(backend, "backend"));
+  const BackendOptions defaults;
+  EXPECT_EQ(o.robust_kernel, ParseRobustKernel(backend["robust_kernel"].as<std::string>()));
+  EXPECT_EQ(o.max_lane_pixel_distance_m, defaults.max_lane_pixel_distance_m);
+  EXPECT_EQ(o.max_outside_image_px, defaults.max_outside_image_px);
+}
+
+}  // namespace
+}  // namespace ipm_road_mapper
