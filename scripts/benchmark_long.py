@@ -55,8 +55,14 @@ def generate_drive(args, drive):
     """Generates the long drive unless cached; returns (wall s, CPU s) of the last generation."""
     scenario = os.path.join(args.repo, "config", "scenarios", SCENARIO + ".yaml")
     timing_path = os.path.join(drive, "generate_time.json")
+    stamp = os.path.join(drive, ".key")  # benchmark.generate rewrites it after generating
+
+    def stamp_time():
+        return os.path.getmtime(stamp) if os.path.exists(stamp) else None
+
+    before = stamp_time()
     wall, cpu = timed(lambda: benchmark.generate(args, scenario, drive))
-    if cpu > 1.0 or not os.path.exists(timing_path):  # generated now (not from the cache)
+    if stamp_time() != before or not os.path.exists(timing_path):
         json.dump({"wall_s": wall, "cpu_s": cpu}, open(timing_path, "w"))
     timing = json.load(open(timing_path))
     return timing["wall_s"], timing["cpu_s"]
@@ -78,25 +84,23 @@ def read_stats(path):
 def cpu_ms_per_frame_by_part(stats, distances_m, total_m, parts):
     """CPU ms per frame in each of `parts` equal distance ranges, from the cpu_s deltas.
 
-    A row's CPU is the cumulative process CPU after its frame, so the cost of the frames of a
-    part is the CPU at its last row minus the CPU at the last row before it; the first row is
-    only the baseline (its CPU includes the start-up).
+    A row's CPU is the cumulative process CPU after its frame, so the cost of a part is the
+    CPU at its last row minus the CPU at the last row before it, divided by the frames in
+    between (frame numbers, so rows may be sparser than frames); the first row is only the
+    baseline (its CPU includes the start-up).
     """
     last_row = [None] * parts
-    count = [0] * parts
     for i, d in enumerate(distances_m):
-        part = min(parts - 1, max(0, int(parts * d / total_m)))
-        last_row[part] = i
-        if i > 0:
-            count[part] += 1
+        last_row[min(parts - 1, max(0, int(parts * d / total_m)))] = i
     result = []
     previous = 0
     for part in range(parts):
-        if last_row[part] is None or count[part] == 0:
+        row = last_row[part]
+        if row is None or stats[row][0] <= stats[previous][0]:
             result.append(None)
             continue
-        result.append(1e3 * (stats[last_row[part]][2] - stats[previous][2]) / count[part])
-        previous = last_row[part]
+        result.append(1e3 * (stats[row][2] - stats[previous][2]) / (stats[row][0] - stats[previous][0]))
+        previous = row
     return result
 
 
@@ -156,6 +160,12 @@ def main(args, out_root):
     gen_wall, gen_cpu = generate_drive(args, drive)
     print("[benchmark] %s: mapping (config/mapper.yaml)" % SCENARIO, file=sys.stderr)
     map_wall, map_cpu = map_drive(args, drive, out)
+    report(args, drive, out, (gen_wall, gen_cpu), (map_wall, map_cpu))
+
+
+def report(args, drive, out, generate_time, map_time):
+    """Evaluates a mapped long drive (map.json, stats.csv, map.log in `out`); prints the table."""
+    (gen_wall, gen_cpu), (map_wall, map_cpu) = generate_time, map_time
     print("[benchmark] %s: evaluating" % SCENARIO, file=sys.stderr)
     gt_path = os.path.join(drive, "ground_truth.json")
     map_path = os.path.join(out, "map.json")

@@ -120,6 +120,12 @@ class StatsTest(unittest.TestCase):
             self.assertAlmostEqual(ms, 10.0, places=6)
         for ms in tenths[5:]:
             self.assertAlmostEqual(ms, 20.0, places=6)
+        # Rows sparser than frames (every 5th frame) give the same cost per frame.
+        sparse = benchmark_long.cpu_ms_per_frame_by_part(stats[::5], distances[::5], 1000.0, 10)
+        for ms in sparse[:4]:
+            self.assertAlmostEqual(ms, 10.0, places=6)
+        for ms in sparse[6:]:
+            self.assertAlmostEqual(ms, 20.0, places=6)
         growth = benchmark_long.slope([d / 1e3 for d in distances],
                                       [row[3] / 1024.0 for row in stats])
         self.assertAlmostEqual(growth, 100.0)  # 1 MB per 10 m
