@@ -15,6 +15,7 @@ import copy
 import math
 
 CELL_M = 20.0
+MAX_RING = 3  # beyond this many cells, the nearest frame is searched among all
 INDEX_STEP_M = 2.0  # frames closer than this to the previous indexed one are not indexed
 
 
@@ -48,8 +49,7 @@ class DriveIndex:
         """Index of the indexed frame (one every INDEX_STEP_M) nearest to (x, y)."""
         cx, cy = self._cell(x, y)
         best, best_d2 = None, float("inf")
-        ring = 0
-        while ring < 1000:
+        for ring in range(MAX_RING + 1):
             for i in range(cx - ring, cx + ring + 1):
                 for j in range(cy - ring, cy + ring + 1):
                     if max(abs(i - cx), abs(j - cy)) != ring:
@@ -61,8 +61,9 @@ class DriveIndex:
             # Every frame outside the rings searched is at least `ring` cells away.
             if best is not None and math.sqrt(best_d2) <= ring * CELL_M:
                 return best
-            ring += 1
-        return best
+        # Far from the drive: every indexed frame.
+        indexed = [k for cell in self.cells.values() for k in cell]
+        return min(indexed, key=lambda k: (self.xy[k][0] - x) ** 2 + (self.xy[k][1] - y) ** 2)
 
     def distance_at_point(self, point):
         """Distance driven at the frame nearest to a map point [x, y, ...]."""

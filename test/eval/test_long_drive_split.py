@@ -53,6 +53,7 @@ class DriveIndexTest(unittest.TestCase):
         self.assertAlmostEqual(index.distance_at_point([123.4, 8.0]), 124.0)  # indexed every 2 m
         self.assertAlmostEqual(index.distance_at_point([-50.0, 0.0]), 0.0)
         self.assertAlmostEqual(index.distance_at_point([900.0, 30.0]), 600.0)
+        self.assertAlmostEqual(index.distance_at_point([1e5, -3e4]), 600.0)  # far: all frames
         self.assertAlmostEqual(index.distance_at_stamp(1000.0 + 0.05 * 10.5), 5.25)
         self.assertAlmostEqual(index.distance_at_stamp(0.0), 0.0)
 
