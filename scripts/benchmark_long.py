@@ -197,6 +197,13 @@ def report(args, drive, out, generate_time, map_time):
     rows.append(["map bytes / km of drive", "%s (map.json %.2f MB)"
                  % (fmt(map_bytes / total_km, 0), map_bytes / 1e6)])
     rows.append(["map bytes / km of lane", fmt(whole.get("map_bytes_per_km"), 0)])
+    md = split.map.get("metadata", {})
+    rows.append(["front end p50 / p95 (whole drive)", "%s / %s ms" % (
+        fmt(md.get("frontend_time_p50_ms"), 2), fmt(md.get("frontend_time_p95_ms"), 2))])
+    solve = [1e3 * md[k] if k in md else None
+             for k in ("backend_solve_time_p50_s", "backend_solve_time_p95_s")]
+    rows.append(["window solve p50 / p95 (whole drive)", "%s / %s ms, %s solves" % (
+        fmt(solve[0], 1), fmt(solve[1], 1), md.get("backend_solves", "-"))])
     rows.append(["marking / lane APE, whole drive", "%s / %s m" % (
         fmt(whole.get("marking_ape_mean_m")), fmt(whole.get("lane_ape_mean_m")))])
     for k, (d0, d1, marking, lane, recall) in enumerate(sixths):
