@@ -6,6 +6,8 @@
 2. the pose update at odometry noise levels 0.1/0.1 .. 0.5/0.5 (m / deg);
 3. the extrinsic and IPM-grid error before and after, and the map with the true extrinsic;
 4. storage per km; plus speed (mapping frames/s, window solve time p50/p95).
+`--long` runs the long-drive benchmark instead (benchmark_long.py: 10 km, CPU and memory per
+distance, APE per sixth of the drive).
 Figures are measured here and printed; nothing is asserted (tests assert loose bounds).
 """
 import argparse
@@ -116,8 +118,13 @@ def main():
     parser.add_argument("--scenarios", default="public_road,port,hilly")
     parser.add_argument("--quick", action="store_true", help="default scenario, no noise sweep")
     parser.add_argument("--out", default=None)
+    parser.add_argument("--long", action="store_true",
+                        help="the long-drive benchmark only (10 km, scripts/benchmark_long.py)")
     args = parser.parse_args()
     out_root = args.out or os.path.join(args.repo, "out", "benchmark")
+    if args.long:
+        import benchmark_long
+        return benchmark_long.main(args, out_root)
     scenarios = ["public_road"] if args.quick else args.scenarios.split(",")
 
     results = {}

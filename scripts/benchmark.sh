@@ -2,6 +2,7 @@
 # Runs the ablations on the synthetic scenarios and prints the paper-style tables
 # (scripts/benchmark.py). Drives are cached in out/benchmark/drives. Options are passed on:
 #   bash scripts/benchmark.sh [--scenarios public_road,port,hilly] [--quick]
+#   bash scripts/benchmark.sh --long     # the 10 km long-drive benchmark alone (docs/benchmark.md)
 set -eo pipefail
 repo="$(cd "$(dirname "${BASH_SOURCE[0]}")/.." && pwd)"
 build="${IRM_BUILD_DIR:-$repo/.build}"

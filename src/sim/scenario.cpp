@@ -1,9 +1,9 @@
+#include "ipm_road_mapper/sim/scenario.h"
+
 #include <cmath>
 #include <functional>
 #include <string>
 #include <vector>
-
-#include "ipm_road_mapper/sim/scenario.h"
 
 namespace ipm_road_mapper {
 namespace sim {
@@ -259,6 +259,8 @@ ScenarioOptions LoadScenario(OptionsReader reader, const ClassTable& classes) {
     ParseMarking(e, classes, o.road.lanes, &m);
     o.markings.push_back(m);
   });
+  reader.Read<int>("repeat_count", &o.repeat_count, CheckPositiveInt);
+  RepeatRoute(o.repeat_count, &o);
   ParseVehicle(reader.Child("vehicle"), o.road.lanes, &o.vehicle);
   ParseCamera(reader.Child("camera"), &o.camera);
   ParseRough(reader.Child("rough_extrinsic"), &o.rough_extrinsic);

@@ -166,6 +166,7 @@ struct IpmCheckOptions {
 struct ScenarioOptions {
   std::string name;
   double start_time_s = 1000.0;  // stamp of the first camera frame
+  int repeat_count = 1;          // the route (road + markings) laid end to end this many times
   RoadOptions road;
   std::vector<MarkingPlacement> markings;
   VehicleOptions vehicle;
@@ -179,6 +180,12 @@ struct ScenarioOptions {
 // Reads and validates a scenario; class names are resolved against `classes`. Throws
 // OptionsError naming the key path on any problem.
 ScenarioOptions LoadScenario(OptionsReader reader, const ClassTable& classes);
+
+// Lays the route `count` times end to end (long drives): copy k of the road segments, grade
+// knots, bumps and marking placements is shifted by k times the road length; waves are
+// functions of s and stay as they are. Throws OptionsError when the grade knots span the
+// road's whole length (the shifted copies would not be in increasing s).
+void RepeatRoute(int count, ScenarioOptions* scenario);
 
 // Same, from a file; the error message starts with the file path.
 ScenarioOptions LoadScenarioFile(const std::string& path, const ClassTable& classes);
