@@ -187,6 +187,7 @@ void LaneTracker::MergeLines() {
                 [](const LaneMeasurement& x, const LaneMeasurement& y) {
                   return x.frame_index < y.frame_index;
                 });
+      first.pruned += second.pruned;
       first.first_frame = std::min(first.first_frame, second.first_frame);
       first.last_frame = std::max(first.last_frame, second.last_frame);
       first.first_seen = std::min(first.first_seen, second.first_seen);
@@ -212,7 +213,7 @@ void LaneTracker::DropSpurious(std::size_t frame_index) {
   const std::size_t before = lanes.size();
   lanes.erase(std::remove_if(lanes.begin(), lanes.end(),
                              [&](const LaneElement& e) {
-                               return e.history.size() == 1 &&
+                               return e.Observations() == 1 &&
                                       frame_index > e.last_frame + horizon;
                              }),
               lanes.end());

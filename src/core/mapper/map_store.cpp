@@ -1,5 +1,7 @@
 #include "ipm_road_mapper/core/mapper/map_store.h"
 
+#include <algorithm>
+
 #include "ipm_road_mapper/core/geometry/catmull_rom_spline.h"
 
 namespace ipm_road_mapper {
@@ -23,6 +25,28 @@ const FrameRecord& MapStore::AddFrame(double stamp, const Eigen::Isometry3d& T_m
 void MapStore::SetFramePose(std::size_t index, const Eigen::Isometry3d& T_map_base) {
   map_.frames[index].T_map_base = T_map_base;
   frame_index_.Set(index, T_map_base.translation());
+}
+
+namespace {
+
+// Erases the measurements of frames before `frame` (histories are sorted by frame).
+template <typename Element>
+void PruneBefore(std::size_t frame, Element* e) {
+  auto keep = std::lower_bound(
+      e->history.begin(), e->history.end(), frame,
+      [](const auto& measurement, std::size_t f) { return measurement.frame_index < f; });
+  const std::size_t n = static_cast<std::size_t>(keep - e->history.begin());
+  if (n == 0) return;
+  e->history.erase(e->history.begin(), keep);
+  e->history.shrink_to_fit();
+  e->pruned += n;
+}
+
+}  // namespace
+
+void MapStore::PruneHistoriesBefore(std::size_t frame) {
+  for (MarkingElement& m : map_.markings) PruneBefore(frame, &m);
+  for (LaneElement& l : map_.lanes) PruneBefore(frame, &l);
 }
 
 void MapStore::Clear() {

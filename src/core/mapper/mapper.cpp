@@ -93,10 +93,20 @@ FrameStatus Mapper::ProcessFrame(const FrameInput& input, std::string* reason) {
   lanes_.Update(observations.lanes, frame);
   markings_.DropSpurious(frame.index);
   lanes_.DropSpurious(frame.index);
+  PruneHistories();
   AppendBounded(&frontend_timing_.total_ms, elapsed_ms(start));
   ++counters_.frames_used;
   windows_.OnFrameUsed(counters_.frames_used, input.camera);
   return FrameStatus::kUsed;
+}
+
+void Mapper::PruneHistories() {
+  // Every kPruneEveryFrames frames, so that the erasures are batched.
+  constexpr std::size_t kPruneEveryFrames = 100;
+  const std::size_t frames = store_.frames().size();
+  const std::size_t span = static_cast<std::size_t>(options_.backend.final_global_max_frames);
+  if (frames % kPruneEveryFrames != 0 || frames <= span) return;
+  store_.PruneHistoriesBefore(frames - span);
 }
 
 void Mapper::Reset() {
@@ -117,20 +127,20 @@ VectorMap Mapper::ExportMap() const {
   };
   // An element seen once is tentative (a spurious blob, until seen again): not exported.
   for (const MarkingElement& element : store_.markings()) {
-    if (element.history.size() < 2) continue;
+    if (element.Observations() < 2) continue;
     MapMarking marking;
     marking.id = element.id;
     marking.class_id = element.class_id;
     marking.class_name = class_name(element.class_id);
     marking.corners_map = element.corners_map;
-    marking.observations = static_cast<int>(element.history.size());
+    marking.observations = static_cast<int>(element.Observations());
     marking.first_seen = element.first_seen;
     marking.last_seen = element.last_seen;
     out.markings.push_back(marking);
   }
   const bool refit = !windows_.LanesRefined();
   for (const LaneElement& element : store_.lanes()) {
-    if (element.history.size() < 2) continue;
+    if (element.Observations() < 2) continue;
     MapLane lane;
     lane.id = element.id;
     lane.class_id = element.class_id;
@@ -142,7 +152,7 @@ VectorMap Mapper::ExportMap() const {
     lane.control_points_map =
         refit ? lanes_.RefitControlPoints(element, camera_, windows_.T_base_cam())
               : element.control_points_map;
-    lane.observations = static_cast<int>(element.history.size());
+    lane.observations = static_cast<int>(element.Observations());
     lane.first_seen = element.first_seen;
     lane.last_seen = element.last_seen;
     out.lanes.push_back(std::move(lane));

@@ -63,6 +63,7 @@ void Absorb(MarkingElement* first, const MarkingElement& second) {
   first->last_frame = std::max(first->last_frame, second.last_frame);
   first->first_seen = std::min(first->first_seen, second.first_seen);
   first->last_seen = std::max(first->last_seen, second.last_seen);
+  first->pruned += second.pruned;
   first->optimized = first->optimized || second.optimized;
   if (second.center_cov_map.trace() < first->center_cov_map.trace()) {
     first->center_cov_map = second.center_cov_map;
@@ -150,7 +151,7 @@ void MarkingTracker::Associate(const std::vector<MarkingObservation>& observatio
     }
     if (element.optimized) continue;  // the back end owns the estimate
     // Plain IPM estimate: the running mean of the observed corners in the map.
-    const double n = static_cast<double>(element.history.size());
+    const double n = static_cast<double>(element.Observations());
     for (int i = 0; i < 4; ++i) {
       element.corners_map[i] +=
           (candidates[c].corners_map[(i + shift) % 4] - element.corners_map[i]) / n;
@@ -180,7 +181,7 @@ void MarkingTracker::MergeDuplicates() {
         continue;
       }
       // The better-observed element stays (its id and its corners).
-      if (markings[b].history.size() > markings[a].history.size()) {
+      if (markings[b].Observations() > markings[a].Observations()) {
         std::swap(markings[a], markings[b]);
       }
       Absorb(&markings[a], markings[b]);
@@ -196,7 +197,7 @@ void MarkingTracker::DropSpurious(std::size_t frame_index) {
   const std::size_t before = markings.size();
   markings.erase(std::remove_if(markings.begin(), markings.end(),
                                 [&](const MarkingElement& e) {
-                                  return e.history.size() == 1 &&
+                                  return e.Observations() == 1 &&
                                          frame_index > e.last_frame + horizon;
                                 }),
                  markings.end());

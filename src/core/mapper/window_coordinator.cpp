@@ -1,12 +1,14 @@
 #include "ipm_road_mapper/core/mapper/window_coordinator.h"
 
 #include <algorithm>
+#include <iterator>
 #include <cmath>
 #include <set>
 #include <unordered_map>
 
 #include "ipm_road_mapper/core/backend/extrinsic_marginalization.h"
 #include "ipm_road_mapper/core/frontend/marking_measurement.h"
+#include "ipm_road_mapper/core/geometry/catmull_rom_spline.h"
 
 namespace ipm_road_mapper {
 namespace {
@@ -26,6 +28,34 @@ bool SeenUpClose(const MarkingElement& m) {
     if (center.head<2>().norm() <= kMatureRangeM) return true;
   }
   return false;
+}
+
+// The part of a lane a window needs: the control points near its measurements' points (at
+// the frames' current poses), with a margin of two chords and the pixel gate, plus two more
+// on each side, so that every segment a pixel can fall on, and every smoothness triple
+// touching a point that can move, lies inside. A lane can be kilometers long; a window
+// looks at tens of meters of it. Writes the part and its global index of the first point.
+void SliceForWindow(const LaneElement& lane, const std::vector<const LaneMeasurement*>& window,
+                    const std::vector<FrameRecord>& frames, double margin_m, WindowLane* out) {
+  std::vector<Eigen::Vector3d> points_map;
+  for (const LaneMeasurement* m : window) {
+    const Eigen::Isometry3d& T_map_base = frames[m->frame_index].T_map_base;
+    for (std::size_t i = 0; i < m->points.size(); ++i) {
+      if (m->selected[i]) points_map.push_back(T_map_base * m->points[i].p_base);
+    }
+  }
+  const std::vector<Eigen::Vector3d>& cps = lane.control_points_map;
+  std::size_t first = 0, last = cps.empty() ? 0 : cps.size() - 1;
+  if (ControlPointRangeNear(cps, points_map, margin_m, &first, &last)) {
+    first = first >= 2 ? first - 2 : 0;
+    last = std::min(cps.size() - 1, last + 2);
+  } else {
+    first = 0;
+    last = cps.empty() ? 0 : cps.size() - 1;
+  }
+  out->first_cp_index = lane.first_cp_index + static_cast<std::int64_t>(first);
+  out->control_points_map.assign(cps.begin() + first,
+                                 cps.empty() ? cps.end() : cps.begin() + last + 1);
 }
 
 }  // namespace
@@ -117,29 +147,43 @@ void WindowCoordinator::RetireMarking(MarkingElement* marking) {
 void WindowCoordinator::FinalGlobalSolve() {
   const BackendOptions& o = options_.backend;
   const std::vector<FrameRecord>& frames = store_->frames();
-  if (!o.final_global_solve || frames.empty() ||
-      frames.size() > static_cast<std::size_t>(o.final_global_max_frames)) {
-    return;
-  }
-  // Everything at once: all frames free, every marking that reached the back end and every
-  // lane with all their observations, the extrinsic with the mounting prior alone (all the
-  // data it summarizes is in the problem itself).
+  if (!o.final_global_solve || frames.empty()) return;
+  // Everything at once over the last final_global_max_frames frames (all of a shorter
+  // drive): those frames free, every marking that reached the back end and every lane with
+  // their observations in that span, the extrinsic with the mounting prior alone (all the
+  // data it summarizes is in the problem itself, for a drive within the span). Older frames
+  // keep what the windows made of them: the solve's cost and memory are bounded by the span.
+  const std::size_t span = static_cast<std::size_t>(o.final_global_max_frames);
+  const std::size_t start = frames.size() > span ? frames.size() - span : 0;
   WindowSnapshot snapshot;
   snapshot.sequence = next_sequence_++;
   snapshot.camera = camera_;
   snapshot.T_base_cam = T_base_cam_;
   snapshot.extrinsic_prior =
       ExtrinsicPrior(T_base_cam_initial_, o.rotation_prior_sigma_rad, o.translation_prior_sigma_m);
+  auto in_span = [start](const auto& measurement) { return measurement.frame_index >= start; };
   for (const MarkingElement& m : store_->markings()) {
-    if (!m.optimized) continue;
-    snapshot.markings.push_back({m.id, m.corners_map, m.history,
-                                 store_->RoadDirectionAt(m.Center()),
-                                 m.history.size() >= kMinMatureObservations});
+    if (!m.optimized || m.last_frame < start) continue;
+    WindowMarking wm{m.id, m.corners_map, {}, store_->RoadDirectionAt(m.Center()),
+                     m.Observations() >= kMinMatureObservations};
+    std::copy_if(m.history.begin(), m.history.end(), std::back_inserter(wm.measurements),
+                 in_span);
+    snapshot.markings.push_back(std::move(wm));
   }
+  const double margin_m = 2.0 * options_.lanes.fit.chord_spacing_m + o.max_lane_pixel_distance_m;
   for (const LaneElement& l : store_->lanes()) {
-    snapshot.lanes.push_back({l.id, l.first_cp_index, l.control_points_map, l.history});
+    if (l.last_frame < start) continue;
+    std::vector<const LaneMeasurement*> span_measurements;
+    for (const LaneMeasurement& m : l.history) {
+      if (in_span(m)) span_measurements.push_back(&m);
+    }
+    WindowLane wl{l.id, l.first_cp_index, l.control_points_map, {}};
+    if (start > 0) SliceForWindow(l, span_measurements, frames, margin_m, &wl);
+    for (const LaneMeasurement* m : span_measurements) wl.measurements.push_back(*m);
+    snapshot.lanes.push_back(std::move(wl));
   }
-  for (const FrameRecord& f : frames) {
+  for (std::size_t i = start; i < frames.size(); ++i) {
+    const FrameRecord& f = frames[i];
     snapshot.frames.push_back({f.index, f.T_map_base, f.T_map_base_odom, true, f.stamp});
   }
   BackendOptions global = o;
@@ -185,19 +229,28 @@ WindowSnapshot WindowCoordinator::BuildSnapshot() {
     if (m.last_frame < first) continue;  // outside the window: held fixed
     if (!SeenUpClose(m)) continue;       // the front end's estimate until it is
     WindowMarking wm{m.id, m.corners_map, m.history, store_->RoadDirectionAt(m.Center()),
-                     m.optimized && m.history.size() >= kMinMatureObservations};
+                     m.optimized && m.Observations() >= kMinMatureObservations};
     for (const MarkingMeasurement& meas : m.history) {
       if (meas.frame_index < first) context.insert(meas.frame_index);
     }
     snapshot.markings.push_back(std::move(wm));
   }
+  const double margin_m =
+      2.0 * options_.lanes.fit.chord_spacing_m + options_.backend.max_lane_pixel_distance_m;
   for (const LaneElement& l : store_->lanes()) {
     if (l.last_frame < first) continue;
-    WindowLane wl{l.id, l.first_cp_index, l.control_points_map, {}};
-    for (const LaneMeasurement& meas : l.history) {
-      if (meas.frame_index < std::max(lane_first, l.retired_before_frame)) continue;
-      wl.measurements.push_back(meas);
-      if (meas.frame_index < first) context.insert(meas.frame_index);
+    // The history is sorted by frame: the window's part is its tail.
+    const std::size_t from = std::max(lane_first, l.retired_before_frame);
+    auto begin = std::lower_bound(
+        l.history.begin(), l.history.end(), from,
+        [](const LaneMeasurement& m, std::size_t f) { return m.frame_index < f; });
+    std::vector<const LaneMeasurement*> window;
+    for (auto it = begin; it != l.history.end(); ++it) window.push_back(&*it);
+    WindowLane wl{l.id, 0, {}, {}};
+    SliceForWindow(l, window, frames, margin_m, &wl);
+    for (const LaneMeasurement* meas : window) {
+      wl.measurements.push_back(*meas);
+      if (meas->frame_index < first) context.insert(meas->frame_index);
     }
     snapshot.lanes.push_back(std::move(wl));
   }

@@ -95,10 +95,11 @@ struct BackendOptions {
   bool motion_prior = true;
   Eigen::Vector3d motion_sigma_acc_mps2{1.0, 1.0, 2.0};            // x y z
   Eigen::Vector3d motion_sigma_angular_acc_radps2{0.5, 0.5, 0.2};  // roll pitch yaw
-  // At the end of input, one solve over the whole drive (Mapper::Finish), when it has at
-  // most final_global_max_frames frames; final_global_rounds alternations.
+  // At the end of input, one solve over the last final_global_max_frames frames (the whole
+  // of a shorter drive; Mapper::Finish), final_global_rounds alternations. Measurements
+  // older than that span are pruned from the elements' histories: nothing reads them again.
   bool final_global_solve = true;
-  int final_global_max_frames = 3000;
+  int final_global_max_frames = 1500;
   int final_global_rounds = 3;
 };
 

@@ -39,11 +39,16 @@ struct MarkingElement {
   // x-y covariance of the estimate for association: Omega_p of the best observation (the
   // plain-IPM errors of one element's observations are correlated, so no 1/n).
   Eigen::Matrix2d center_cov_map = Eigen::Matrix2d::Zero();
-  std::vector<MarkingMeasurement> history;
+  std::vector<MarkingMeasurement> history;  // sorted by frame; the oldest pruned (below)
+  // Measurements pruned from the history (older than the final solve's horizon): counted,
+  // not kept, so that memory grows with the map and not with the frames seen.
+  std::size_t pruned = 0;
   std::size_t first_frame = 0, last_frame = 0;
   double first_seen = 0.0, last_seen = 0.0;
   bool optimized = false;  // the back end owns the estimate from now on
   bool retired = false;    // left the window: its information is in the extrinsic prior
+  // Every observation ever made, pruned ones included.
+  std::size_t Observations() const { return history.size() + pruned; }
   Eigen::Vector3d Center() const {
     return 0.25 * (corners_map[0] + corners_map[1] + corners_map[2] + corners_map[3]);
   }
@@ -68,10 +73,13 @@ struct LaneElement {
   // Global index of control_points_map[0]; decreases as the lane grows at its start, so
   // back-end results computed on an older copy can be applied point by point.
   std::int64_t first_cp_index = 0;
-  std::vector<LaneMeasurement> history;
+  std::vector<LaneMeasurement> history;  // sorted by frame; the oldest pruned (below)
+  std::size_t pruned = 0;                // measurements pruned from the history
   std::size_t first_frame = 0, last_frame = 0;
   double first_seen = 0.0, last_seen = 0.0;
   bool optimized = false;  // control points refined by a lane residual
+  // Every observation ever made, pruned ones included.
+  std::size_t Observations() const { return history.size() + pruned; }
   // Observations of frames before this one no longer enter windows.
   std::size_t retired_before_frame = 0;
 };

@@ -25,6 +25,9 @@ class MapStore {
   void SetFramePose(std::size_t index, const Eigen::Isometry3d& T_map_base);
   // A fresh element id.
   std::uint64_t NewId() { return map_.next_id++; }
+  // Drops the measurements of frames before `frame` from every element's history (counted
+  // in `pruned`): what export and association need stays (corners, control points, spans).
+  void PruneHistoriesBefore(std::size_t frame);
   // Drops every frame and element (ids keep counting).
   void Clear();
 

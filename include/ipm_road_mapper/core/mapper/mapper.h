@@ -77,6 +77,10 @@ class Mapper {
  private:
   std::string ValidateInput(const FrameInput& input) const;
   void Skip(const std::string& reason, std::string* out);
+  // Drops the measurements older than the final solve's span (backend.final_global_max_frames
+  // frames) from the histories: no later step reads them, and memory then grows with the
+  // map, not with the frames seen.
+  void PruneHistories();
 
   // Declaration order is construction order: the rooms hold pointers to what precedes them.
   const MapperOptions options_;
