@@ -38,19 +38,20 @@
 #include <stdexcept>
 #include <string>
 
-#include "ipm_road_mapper/pipeline/frame_assembler.h"
-#include "ipm_road_mapper/core/io/geojson_export.h"
-#include "ipm_road_mapper/core/mapper/mapper.h"
 #include "ipm_road_mapper/core/geometry/rigid_transform.h"
+#include "ipm_road_mapper/core/io/geojson_export.h"
 #include "ipm_road_mapper/core/map/vector_map.h"
-#include "ipm_road_mapper/ros/bag_input.h"
-#include "ipm_road_mapper/ros/bag_prefetcher.h"
+#include "ipm_road_mapper/core/mapper/mapper.h"
 #include "ipm_road_mapper/pipeline/extrinsic_source.h"
+#include "ipm_road_mapper/pipeline/frame_assembler.h"
 #include "ipm_road_mapper/pipeline/map_files.h"
 #include "ipm_road_mapper/pipeline/mapper_config.h"
 #include "ipm_road_mapper/pipeline/mapping_session.h"
-#include "ipm_road_mapper/ros/msg_conversion.h"
+#include "ipm_road_mapper/pipeline/process_stats.h"
 #include "ipm_road_mapper/pipeline/progress_meter.h"
+#include "ipm_road_mapper/ros/bag_input.h"
+#include "ipm_road_mapper/ros/bag_prefetcher.h"
+#include "ipm_road_mapper/ros/msg_conversion.h"
 
 namespace ipm_road_mapper {
 namespace {
@@ -145,6 +146,7 @@ struct RunStats {
   std::size_t frames_read = 0;
   double bag_span_s = 0.0;
   double wall_s = 0.0;
+  std::optional<double> startup_s;  // process start to the first frame mapped
   std::string extrinsic_source;
 };
 
@@ -179,6 +181,14 @@ std::string FrontEndLine(const Mapper& mapper) {
   return s.str();
 }
 
+// Seconds with 3 decimals, or "none" when no frame was mapped.
+std::string StartupText(const std::optional<double>& startup_s) {
+  if (!startup_s) return "none";
+  char text[32];
+  std::snprintf(text, sizeof(text), "%.3f", *startup_s);
+  return text;
+}
+
 std::string Summary(const Arguments& args, const Mapper& mapper, const FrameAssembler& assembler,
                     const VectorMap& map, const RunStats& stats) {
   const MapperCounters& c = mapper.counters();
@@ -205,6 +215,8 @@ std::string Summary(const Arguments& args, const Mapper& mapper, const FrameAsse
     << c.lane_observations_unused << ", near a lane " << c.lane_observations_near_lane << ")\n"
     << BackendLine(mapper) << "\n"
     << FrontEndLine(mapper) << "\n"
+    << "startup_s: " << StartupText(stats.startup_s)
+    << " (process start to the first frame mapped)\n"
     << "wall time: " << stats.wall_s << " s; "
     << (stats.wall_s > 0 ? stats.frames_read / stats.wall_s : 0.0) << " frames/s; bag span "
     << stats.bag_span_s << " s; real-time factor "
@@ -215,20 +227,20 @@ std::string Summary(const Arguments& args, const Mapper& mapper, const FrameAsse
 
 // Hands a mask message to the session, or counts why it cannot be a frame.
 void AddMask(const sensor_msgs::Image& msg, const CameraInfoTable& camera_infos, bool exact_sync,
-             MappingSession* session) {
+             MappingSession* session, SessionUpdate* update) {
   cv::Mat mask;
   std::string error = ImageToMask(msg, &mask);
   if (!error.empty()) {
-    session->CountSkipped("bad_mask_encoding: " + error, nullptr);
+    session->CountSkipped("bad_mask_encoding: " + error, update);
     return;
   }
   CameraIntrinsics camera;
   error = camera_infos.Match(msg.header.stamp, exact_sync, &camera);
   if (!error.empty()) {
-    session->CountSkipped(error, nullptr);
+    session->CountSkipped(error, update);
     return;
   }
-  session->AddFrame(ToSeconds(msg.header.stamp), std::move(mask), camera, nullptr);
+  session->AddFrame(ToSeconds(msg.header.stamp), std::move(mask), camera, update);
 }
 
 void WriteOutputs(const std::string& dir, const VectorMap& map,
@@ -289,7 +301,10 @@ int Run(int argc, char** argv) {
     // The bag is read and deserialized ahead, in its own thread; mapping stays in this one.
     BagPrefetcher prefetcher(bag, input.mask_topic, input.odom_topic);
     BagPrefetcher::Item message;
+    SessionUpdate update;
     while (prefetcher.Next(&message)) {
+      update.used.clear();
+      update.skipped.clear();
       if (!message.is_mask) {
         StampedPose pose;
         // An unconvertible message (e.g. a zero quaternion) is handed on as a NaN pose, so
@@ -297,14 +312,18 @@ int Run(int argc, char** argv) {
         if (!message.odometry || !OdometryToStampedPose(*message.odometry, &pose).empty()) {
           pose.T_map_base.matrix().setConstant(std::numeric_limits<double>::quiet_NaN());
         }
-        session.AddOdometry(pose, nullptr);
+        session.AddOdometry(pose, &update);
       } else {
         if (message.mask) {
-          AddMask(*message.mask, camera_infos, exact_sync, &session);
+          AddMask(*message.mask, camera_infos, exact_sync, &session, &update);
         } else {
           session.CountSkipped("bad_mask_message: not a sensor_msgs/Image", nullptr);
         }
         progress.Update(++stats.frames_read);
+      }
+      if (!stats.startup_s && !update.used.empty()) {
+        stats.startup_s = SecondsSinceProcessStart();
+        std::fprintf(stderr, "map_from_bag: first frame mapped after %.3f s\n", *stats.startup_s);
       }
     }
   }
