@@ -8,8 +8,9 @@
 // windows); --async keeps the config's threading, as the nodelet runs it.
 //
 // Reads the mask, camera_info and odometry topics of the config's `input` section with the
-// rosbag C++ API (masks and odometry read ahead in a thread: BagPrefetcher), pairs each mask with
-// its camera_info (sync exact: identical stamp; approximate: nearest within half a frame period)
+// rosbag C++ API in one pass (read ahead in a thread: BagPrefetcher; mapping starts with the
+// first messages), pairs each mask with its camera_info (sync exact: identical stamp;
+// approximate: nearest within half the period of the first camera_infos)
 // and with odometry interpolated at its stamp (FrameAssembler, the same code the nodelet uses),
 // runs the core Mapper, and writes <dir>/map.json, <dir>/map.geojson, <dir>/trajectory_tum.txt and
 // <dir>/summary.txt. The rough extrinsic T_base_cam is the config's input.extrinsic when given,
@@ -49,6 +50,7 @@
 #include "ipm_road_mapper/pipeline/mapping_session.h"
 #include "ipm_road_mapper/pipeline/process_stats.h"
 #include "ipm_road_mapper/pipeline/progress_meter.h"
+#include "ipm_road_mapper/ros/bag_camera_info.h"
 #include "ipm_road_mapper/ros/bag_input.h"
 #include "ipm_road_mapper/ros/bag_prefetcher.h"
 #include "ipm_road_mapper/ros/msg_conversion.h"
@@ -225,22 +227,87 @@ std::string Summary(const Arguments& args, const Mapper& mapper, const FrameAsse
   return s.str();
 }
 
-// Hands a mask message to the session, or counts why it cannot be a frame.
-void AddMask(const sensor_msgs::Image& msg, const CameraInfoTable& camera_infos, bool exact_sync,
-             MappingSession* session, SessionUpdate* update) {
+// Hands a paired mask to the session, or counts why it cannot be a frame (a bad encoding
+// first, then a missing or bad camera_info).
+void AddMask(const PairedMask& paired, MappingSession* session, SessionUpdate* update) {
   cv::Mat mask;
-  std::string error = ImageToMask(msg, &mask);
+  const std::string error = ImageToMask(*paired.mask, &mask);
   if (!error.empty()) {
     session->CountSkipped("bad_mask_encoding: " + error, update);
-    return;
+  } else if (!paired.error.empty()) {
+    session->CountSkipped(paired.error, update);
+  } else {
+    session->AddFrame(ToSeconds(paired.mask->header.stamp), std::move(mask), paired.camera, update);
   }
-  CameraIntrinsics camera;
-  error = camera_infos.Match(msg.header.stamp, exact_sync, &camera);
-  if (!error.empty()) {
-    session->CountSkipped(error, update);
-    return;
+}
+
+// Odometry as the assembler takes it: an unconvertible message (null, a zero quaternion)
+// becomes a NaN pose, so it is counted as bad_odometry like any other invalid pose.
+StampedPose ToPose(const nav_msgs::Odometry::ConstPtr& odometry) {
+  StampedPose pose;
+  if (!odometry || !OdometryToStampedPose(*odometry, &pose).empty()) {
+    pose.T_map_base.matrix().setConstant(std::numeric_limits<double>::quiet_NaN());
   }
-  session->AddFrame(ToSeconds(msg.header.stamp), std::move(mask), camera, update);
+  return pose;
+}
+
+// Streams the bag through the session: masks, odometry and camera_info in one pass, read
+// and deserialized ahead in the BagPrefetcher's thread; each mask waits for its camera_info
+// (CameraInfoPairing) and goes to the session in bag order. Mapping starts with the first
+// messages: only the first camera_infos are read beforehand (the sync tolerance).
+void MapBag(const rosbag::Bag& bag, const InputOptions& input, MappingSession* session,
+            ProgressMeter* progress, RunStats* stats) {
+  CameraInfoPairing pairing(
+      CameraInfoTable(CameraInfoTable::ToleranceFromFirstMessages(bag, input.camera_info_topic)),
+      input.sync == "exact");
+  SessionUpdate update;
+  // After each message: the first frame mapped is reported once.
+  const auto note_first_frame = [&] {
+    if (!stats->startup_s && !update.used.empty()) {
+      stats->startup_s = SecondsSinceProcessStart();
+      std::fprintf(stderr, "map_from_bag: first frame mapped after %.3f s\n", *stats->startup_s);
+    }
+    update.used.clear();
+    update.skipped.clear();
+  };
+  std::vector<PairedMask> paired;
+  const auto add_paired = [&] {
+    for (const PairedMask& frame : paired) {
+      AddMask(frame, session, &update);
+      progress->Update(++stats->frames_read);
+      note_first_frame();
+    }
+    paired.clear();
+  };
+  {
+    BagPrefetcher prefetcher(bag, {input.mask_topic, input.odom_topic, input.camera_info_topic});
+    BagPrefetcher::Item message;
+    while (prefetcher.Next(&message)) {
+      switch (message.kind) {
+        case BagPrefetcher::Kind::kOdometry:
+          session->AddOdometry(ToPose(message.odometry), &update);
+          note_first_frame();
+          break;
+        case BagPrefetcher::Kind::kCameraInfo:
+          // One that does not deserialize is left out (its mask reports no_camera_info).
+          if (message.camera_info) pairing.AddCameraInfo(*message.camera_info, &paired);
+          break;
+        case BagPrefetcher::Kind::kMask:
+          if (message.mask) {
+            pairing.AddMask(message.mask, &paired);
+          } else {
+            session->CountSkipped("bad_mask_message: not a sensor_msgs/Image", &update);
+            progress->Update(++stats->frames_read);
+          }
+          break;
+      }
+      add_paired();
+    }
+  }
+  pairing.Flush(&paired);
+  add_paired();
+  session->Finish(&update);  // waiting frames decided, the last window's solve merged
+  note_first_frame();
 }
 
 void WriteOutputs(const std::string& dir, const VectorMap& map,
@@ -285,49 +352,20 @@ int Run(int argc, char** argv) {
     throw InputError(args.out + ": cannot create output folder: " + dir_error.message());
   }
 
-  const CameraInfoTable camera_infos = CameraInfoTable::Read(bag, input.camera_info_topic);
-  const bool exact_sync = input.sync == "exact";
   // The same pipeline as the nodelet's; no odometry wait rule offline (the bag is complete).
   MappingSession session(options, classes);
   session.Start(T_base_cam);
+  // Counts and span from the bag's index (no message is read).
   rosbag::View span_view(bag, rosbag::TopicQuery({input.mask_topic, input.odom_topic}));
   const std::size_t total_masks = rosbag::View(bag, rosbag::TopicQuery(input.mask_topic)).size();
-  std::cerr << "map_from_bag: " << total_masks << " masks, " << camera_infos.size()
+  const std::size_t total_camera_infos =
+      rosbag::View(bag, rosbag::TopicQuery(input.camera_info_topic)).size();
+  std::cerr << "map_from_bag: " << total_masks << " masks, " << total_camera_infos
             << " camera_infos; extrinsic from " << stats.extrinsic_source << "\n";
 
   ProgressMeter progress(total_masks, "frames");
   const auto start = std::chrono::steady_clock::now();
-  {
-    // The bag is read and deserialized ahead, in its own thread; mapping stays in this one.
-    BagPrefetcher prefetcher(bag, input.mask_topic, input.odom_topic);
-    BagPrefetcher::Item message;
-    SessionUpdate update;
-    while (prefetcher.Next(&message)) {
-      update.used.clear();
-      update.skipped.clear();
-      if (!message.is_mask) {
-        StampedPose pose;
-        // An unconvertible message (e.g. a zero quaternion) is handed on as a NaN pose, so
-        // the assembler counts it as bad_odometry like any other invalid pose.
-        if (!message.odometry || !OdometryToStampedPose(*message.odometry, &pose).empty()) {
-          pose.T_map_base.matrix().setConstant(std::numeric_limits<double>::quiet_NaN());
-        }
-        session.AddOdometry(pose, &update);
-      } else {
-        if (message.mask) {
-          AddMask(*message.mask, camera_infos, exact_sync, &session, &update);
-        } else {
-          session.CountSkipped("bad_mask_message: not a sensor_msgs/Image", nullptr);
-        }
-        progress.Update(++stats.frames_read);
-      }
-      if (!stats.startup_s && !update.used.empty()) {
-        stats.startup_s = SecondsSinceProcessStart();
-        std::fprintf(stderr, "map_from_bag: first frame mapped after %.3f s\n", *stats.startup_s);
-      }
-    }
-  }
-  session.Finish(nullptr);  // waiting frames decided, the last window's solve merged
+  MapBag(bag, input, &session, &progress, &stats);
   progress.Finish();
   stats.wall_s = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
   stats.bag_span_s = (span_view.getEndTime() - span_view.getBeginTime()).toSec();
