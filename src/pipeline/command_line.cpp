@@ -144,14 +144,11 @@ bool CommandLine::Parse(int argc, const char* const* argv) {
   po::variables_map values;
   try {
     // No abbreviations: "--conf" must not silently mean "--config".
-    const int style = po::command_line_style::default_style &
-                      ~po::command_line_style::allow_guessing;
-    po::store(po::command_line_parser(argc, argv)
-                  .options(all)
-                  .positional(positional)
-                  .style(style)
-                  .run(),
-              values);
+    const int style =
+        po::command_line_style::default_style & ~po::command_line_style::allow_guessing;
+    po::store(
+        po::command_line_parser(argc, argv).options(all).positional(positional).style(style).run(),
+        values);
   } catch (const po::error& e) {
     throw CommandLineError(Describe(e));
   }
@@ -216,13 +213,12 @@ std::optional<int> CommandLine::ParseOrExitCode(int argc, const char* const* arg
   return ParseOrExitCode(argc, argv, std::cout, std::cerr);
 }
 
-std::int64_t ParseIntegerOption(const std::string& name, const std::string& text,
-                                std::int64_t lo, std::int64_t hi) {
+std::int64_t ParseIntegerOption(const std::string& name, const std::string& text, std::int64_t lo,
+                                std::int64_t hi) {
   errno = 0;
   char* end = nullptr;
   const long long value = std::strtoll(text.c_str(), &end, 10);
-  const bool valid =
-      !text.empty() && *end == '\0' && errno == 0 && value >= lo && value <= hi;
+  const bool valid = !text.empty() && *end == '\0' && errno == 0 && value >= lo && value <= hi;
   if (!valid) {
     const std::string range = hi == std::numeric_limits<std::int64_t>::max()
                                   ? ">= " + std::to_string(lo)

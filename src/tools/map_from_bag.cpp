@@ -1,7 +1,7 @@
 // Offline runner: builds the vector map from a bag file, without a roscore.
 //
 //   rosrun ipm_road_mapper map_from_bag --bag <bag> [--config <yaml>] [--classes <yaml>]
-//                                       [--async] --out <dir>
+//                                       [--async] --out <dir> [--stats-out <csv>]
 //
 // The back end solves every window in turn (backend.synchronous forced on: offline the bag
 // is read far faster than real time, and an owned optimizer thread would drop most
@@ -9,17 +9,20 @@
 //
 // Reads the mask, camera_info and odometry topics of the config's `input` section with the
 // rosbag C++ API in one pass (read ahead in a thread: BagPrefetcher; mapping starts with the
-// first messages), pairs each mask with its camera_info (sync exact: identical stamp;
-// approximate: nearest within half the period of the first camera_infos)
-// and with odometry interpolated at its stamp (FrameAssembler, the same code the nodelet uses),
-// runs the core Mapper, and writes <dir>/map.json, <dir>/map.geojson, <dir>/trajectory_tum.txt and
-// <dir>/summary.txt. The rough extrinsic T_base_cam is the config's input.extrinsic when given,
-// else the bag's /tf_static transform from input.base_frame to the mask's header.frame_id (a chain
-// of static transforms is composed). Defaults: --config and --classes are config/mapper.yaml and
+// first messages), pairs each mask with its camera_info (CameraInfoPairing; sync exact:
+// identical stamp; approximate: nearest within half the period of the first camera_infos)
+// and with odometry interpolated at its stamp (FrameAssembler, the same code the nodelet
+// uses), runs the core Mapper, and writes <dir>/map.json, <dir>/map.geojson,
+// <dir>/trajectory_tum.txt and <dir>/summary.txt (with startup_s: process start to the first
+// frame mapped), and with --stats-out a CSV row per frame (CPU time, RSS). The rough
+// extrinsic T_base_cam is the config's input.extrinsic when given, else the bag's /tf_static
+// transform from input.base_frame to the mask's header.frame_id (a chain of static transforms
+// is composed). Defaults: --config and --classes are config/mapper.yaml and
 // config/classes.yaml of the package, found by rospack (ROS_PACKAGE_PATH), else under
-// $IRM_SOURCE_DIR, else in the install space next to the executable (../../share/ipm_road_mapper).
-// Exit status: 0 done; 2 bad input (missing bag, bad config, missing topic, no extrinsic, ...)
-// with one error line on stderr; 1 an output could not be written.
+// $IRM_SOURCE_DIR, else in the install space next to the executable
+// (../../share/ipm_road_mapper). Exit status: 0 done (or --help); 2 bad input (bad command
+// line, missing bag, bad config, missing topic, no extrinsic, ...) with one error line on
+// stderr; 1 an output could not be written.
 #include <nav_msgs/Odometry.h>
 #include <ros/package.h>
 #include <rosbag/view.h>
@@ -43,6 +46,7 @@
 #include "ipm_road_mapper/core/io/geojson_export.h"
 #include "ipm_road_mapper/core/map/vector_map.h"
 #include "ipm_road_mapper/core/mapper/mapper.h"
+#include "ipm_road_mapper/pipeline/command_line.h"
 #include "ipm_road_mapper/pipeline/extrinsic_source.h"
 #include "ipm_road_mapper/pipeline/frame_assembler.h"
 #include "ipm_road_mapper/pipeline/map_files.h"
@@ -60,10 +64,6 @@ namespace {
 
 namespace fs = std::filesystem;
 
-constexpr const char* kUsage =
-    "usage: map_from_bag --bag <bag> [--config <mapper.yaml>] [--classes <classes.yaml>] "
-    "[--async] --out <dir>";
-
 // Bad input: reported as one line, exit status 2.
 struct InputError : std::runtime_error {
   using std::runtime_error::runtime_error;
@@ -71,7 +71,8 @@ struct InputError : std::runtime_error {
 
 struct Arguments {
   std::string bag, config, classes, out;
-  bool async = false;  // keep backend.synchronous as configured (live-like timing)
+  std::string stats_out;  // empty: no per-frame stats file
+  bool async = false;     // keep backend.synchronous as configured (live-like timing)
 };
 
 // A file of the package (e.g. "config/mapper.yaml"); see the file comment for the search.
@@ -83,31 +84,24 @@ std::string PackageFile(const std::string& relative) {
   }
 }
 
-Arguments ParseArguments(int argc, char** argv) {
-  Arguments args;
-  for (int i = 1; i < argc; ++i) {
-    const std::string flag = argv[i];
-    if (flag == "--async") {
-      args.async = true;
-      continue;
-    }
-    if (flag == "-h" || flag == "--help") {
-      std::cout << kUsage << "\n";
-      std::exit(0);
-    }
-    std::string* target = flag == "--bag"       ? &args.bag
-                          : flag == "--config"  ? &args.config
-                          : flag == "--classes" ? &args.classes
-                          : flag == "--out"     ? &args.out
-                                                : nullptr;
-    if (!target) throw InputError("unknown argument '" + flag + "'; " + kUsage);
-    if (i + 1 >= argc) throw InputError(flag + " needs a value; " + kUsage);
-    *target = argv[++i];
-  }
-  if (args.bag.empty() || args.out.empty()) throw InputError(std::string(kUsage));
-  if (args.config.empty()) args.config = PackageFile("config/mapper.yaml");
-  if (args.classes.empty()) args.classes = PackageFile("config/classes.yaml");
-  return args;
+// Parses the command line (pipeline/command_line.h): the exit code when the tool stops
+// there (--help: 0, a bad command line: 2), else nullopt with *args filled in.
+std::optional<int> ParseArguments(int argc, char** argv, Arguments* args) {
+  CommandLine line("map_from_bag",
+                   "Builds the vector map from a bag file, without a roscore "
+                   "(docs/map_from_bag.md).");
+  line.Required("bag", "<bag>", &args->bag, "the bag to map")
+      .Optional("config", "<mapper.yaml>", &args->config, "config/mapper.yaml of the package",
+                "mapper config (may start with `base: <file>`)")
+      .Optional("classes", "<classes.yaml>", &args->classes, "config/classes.yaml of the package",
+                "mask class table")
+      .Flag("async", &args->async,
+            "keep the config's back-end threading (as live) instead of solving every window "
+            "in turn")
+      .Required("out", "<dir>", &args->out, "output folder (created if needed)")
+      .Optional("stats-out", "<file>", &args->stats_out, "none",
+                "per-frame CSV frame,stamp,cpu_s,rss_kb (docs/map_from_bag.md)");
+  return line.ParseOrExitCode(argc, argv);
 }
 
 // Loads the config (mapper options, geo_origin, the nodelet's `ros` section: the same loader
@@ -223,7 +217,8 @@ std::string Summary(const Arguments& args, const Mapper& mapper, const FrameAsse
     << (stats.wall_s > 0 ? stats.frames_read / stats.wall_s : 0.0) << " frames/s; bag span "
     << stats.bag_span_s << " s; real-time factor "
     << (stats.wall_s > 0 ? stats.bag_span_s / stats.wall_s : 0.0) << "x\n"
-    << "outputs: " << args.out << "/{map.json, map.geojson, trajectory_tum.txt, summary.txt}\n";
+    << "outputs: " << args.out << "/{map.json, map.geojson, trajectory_tum.txt, summary.txt}"
+    << (args.stats_out.empty() ? "" : ", " + args.stats_out) << "\n";
   return s.str();
 }
 
@@ -255,8 +250,9 @@ StampedPose ToPose(const nav_msgs::Odometry::ConstPtr& odometry) {
 // and deserialized ahead in the BagPrefetcher's thread; each mask waits for its camera_info
 // (CameraInfoPairing) and goes to the session in bag order. Mapping starts with the first
 // messages: only the first camera_infos are read beforehand (the sync tolerance).
+// With `frame_stats`, one row per frame after it was handed to the session.
 void MapBag(const rosbag::Bag& bag, const InputOptions& input, MappingSession* session,
-            ProgressMeter* progress, RunStats* stats) {
+            ProgressMeter* progress, FrameStatsWriter* frame_stats, RunStats* stats) {
   CameraInfoPairing pairing(
       CameraInfoTable(CameraInfoTable::ToleranceFromFirstMessages(bag, input.camera_info_topic)),
       input.sync == "exact");
@@ -270,12 +266,17 @@ void MapBag(const rosbag::Bag& bag, const InputOptions& input, MappingSession* s
     update.used.clear();
     update.skipped.clear();
   };
+  // After each frame (a mask message; `stamp` NaN when it did not deserialize).
+  const auto frame_done = [&](double stamp) {
+    if (frame_stats) frame_stats->Add(stats->frames_read, stamp);
+    progress->Update(++stats->frames_read);
+    note_first_frame();
+  };
   std::vector<PairedMask> paired;
   const auto add_paired = [&] {
     for (const PairedMask& frame : paired) {
       AddMask(frame, session, &update);
-      progress->Update(++stats->frames_read);
-      note_first_frame();
+      frame_done(ToSeconds(frame.mask->header.stamp));
     }
     paired.clear();
   };
@@ -297,7 +298,7 @@ void MapBag(const rosbag::Bag& bag, const InputOptions& input, MappingSession* s
             pairing.AddMask(message.mask, &paired);
           } else {
             session->CountSkipped("bad_mask_message: not a sensor_msgs/Image", &update);
-            progress->Update(++stats->frames_read);
+            frame_done(std::numeric_limits<double>::quiet_NaN());
           }
           break;
       }
@@ -319,7 +320,10 @@ void WriteOutputs(const std::string& dir, const VectorMap& map,
 }
 
 int Run(int argc, char** argv) {
-  const Arguments args = ParseArguments(argc, argv);
+  Arguments args;
+  if (const std::optional<int> exit_code = ParseArguments(argc, argv, &args)) return *exit_code;
+  if (args.config.empty()) args.config = PackageFile("config/mapper.yaml");
+  if (args.classes.empty()) args.classes = PackageFile("config/classes.yaml");
   MapperConfig config = LoadConfig(args.config);
   // Offline, every window is solved in turn (the bag is read far faster than real time, so
   // an owned thread would drop most of them); --async keeps the config's threading.
@@ -351,6 +355,9 @@ int Run(int argc, char** argv) {
   if (dir_error || !fs::is_directory(args.out)) {
     throw InputError(args.out + ": cannot create output folder: " + dir_error.message());
   }
+  // Opened before mapping, so an unwritable path fails at once (exit 1).
+  std::optional<FrameStatsWriter> frame_stats;
+  if (!args.stats_out.empty()) frame_stats.emplace(args.stats_out);
 
   // The same pipeline as the nodelet's; no odometry wait rule offline (the bag is complete).
   MappingSession session(options, classes);
@@ -365,7 +372,7 @@ int Run(int argc, char** argv) {
 
   ProgressMeter progress(total_masks, "frames");
   const auto start = std::chrono::steady_clock::now();
-  MapBag(bag, input, &session, &progress, &stats);
+  MapBag(bag, input, &session, &progress, frame_stats ? &*frame_stats : nullptr, &stats);
   progress.Finish();
   stats.wall_s = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
   stats.bag_span_s = (span_view.getEndTime() - span_view.getBeginTime()).toSec();
@@ -377,6 +384,7 @@ int Run(int argc, char** argv) {
   map.metadata["extrinsic_source"] = stats.extrinsic_source;
   const std::string summary = Summary(args, mapper, session.assembler(), map, stats);
   try {
+    if (frame_stats) frame_stats->Close();
     WriteOutputs(args.out, map, config.geo_origin, summary);
   } catch (const std::exception& e) {
     std::cerr << "map_from_bag: error: " << e.what() << "\n";

@@ -29,19 +29,18 @@ class CommandLine {
   CommandLine& operator=(const CommandLine&) = delete;
 
   // --name <value_name>, required.
-  CommandLine& Required(const std::string& name, const std::string& value_name,
-                        std::string* value, const std::string& help);
+  CommandLine& Required(const std::string& name, const std::string& value_name, std::string* value,
+                        const std::string& help);
 
   // --name <value_name>, optional: *value keeps its value when the option is absent;
   // `default_text` says in --help what that means ("none", "config/mapper.yaml of the
   // package").
-  CommandLine& Optional(const std::string& name, const std::string& value_name,
-                        std::string* value, const std::string& default_text,
-                        const std::string& help);
+  CommandLine& Optional(const std::string& name, const std::string& value_name, std::string* value,
+                        const std::string& default_text, const std::string& help);
 
   // --name <value_name>, an integer in [lo, hi]; optional ones keep *value when absent.
-  CommandLine& Integer(const std::string& name, const std::string& value_name,
-                       std::int64_t* value, std::int64_t lo, std::int64_t hi, bool required,
+  CommandLine& Integer(const std::string& name, const std::string& value_name, std::int64_t* value,
+                       std::int64_t lo, std::int64_t hi, bool required,
                        const std::string& default_text, const std::string& help);
 
   // --name, a switch: *value becomes true when it is given (off by default).
@@ -74,7 +73,7 @@ class CommandLine {
 };
 
 // The integer in `text`, checked to lie in [lo, hi]; throws CommandLineError naming `name`.
-std::int64_t ParseIntegerOption(const std::string& name, const std::string& text,
-                                std::int64_t lo, std::int64_t hi);
+std::int64_t ParseIntegerOption(const std::string& name, const std::string& text, std::int64_t lo,
+                                std::int64_t hi);
 
 }  // namespace ipm_road_mapper
