@@ -23,10 +23,8 @@
 // (../../share/ipm_road_mapper). Exit status: 0 done (or --help); 2 bad input (bad command
 // line, missing bag, bad config, missing topic, no extrinsic, ...) with one error line on
 // stderr; 1 an output could not be written.
-#include <nav_msgs/Odometry.h>
 #include <ros/package.h>
 #include <rosbag/view.h>
-#include <sensor_msgs/CameraInfo.h>
 #include <sensor_msgs/Image.h>
 
 #include <chrono>
@@ -36,7 +34,6 @@
 #include <filesystem>
 #include <fstream>
 #include <iostream>
-#include <limits>
 #include <optional>
 #include <sstream>
 #include <stdexcept>
@@ -54,10 +51,8 @@
 #include "ipm_road_mapper/pipeline/mapping_session.h"
 #include "ipm_road_mapper/pipeline/process_stats.h"
 #include "ipm_road_mapper/pipeline/progress_meter.h"
-#include "ipm_road_mapper/ros/bag_camera_info.h"
 #include "ipm_road_mapper/ros/bag_input.h"
-#include "ipm_road_mapper/ros/bag_prefetcher.h"
-#include "ipm_road_mapper/ros/msg_conversion.h"
+#include "ipm_road_mapper/ros/bag_mapping.h"
 
 namespace ipm_road_mapper {
 namespace {
@@ -222,95 +217,6 @@ std::string Summary(const Arguments& args, const Mapper& mapper, const FrameAsse
   return s.str();
 }
 
-// Hands a paired mask to the session, or counts why it cannot be a frame (a bad encoding
-// first, then a missing or bad camera_info).
-void AddMask(const PairedMask& paired, MappingSession* session, SessionUpdate* update) {
-  cv::Mat mask;
-  const std::string error = ImageToMask(*paired.mask, &mask);
-  if (!error.empty()) {
-    session->CountSkipped("bad_mask_encoding: " + error, update);
-  } else if (!paired.error.empty()) {
-    session->CountSkipped(paired.error, update);
-  } else {
-    session->AddFrame(ToSeconds(paired.mask->header.stamp), std::move(mask), paired.camera, update);
-  }
-}
-
-// Odometry as the assembler takes it: an unconvertible message (null, a zero quaternion)
-// becomes a NaN pose, so it is counted as bad_odometry like any other invalid pose.
-StampedPose ToPose(const nav_msgs::Odometry::ConstPtr& odometry) {
-  StampedPose pose;
-  if (!odometry || !OdometryToStampedPose(*odometry, &pose).empty()) {
-    pose.T_map_base.matrix().setConstant(std::numeric_limits<double>::quiet_NaN());
-  }
-  return pose;
-}
-
-// Streams the bag through the session: masks, odometry and camera_info in one pass, read
-// and deserialized ahead in the BagPrefetcher's thread; each mask waits for its camera_info
-// (CameraInfoPairing) and goes to the session in bag order. Mapping starts with the first
-// messages: only the first camera_infos are read beforehand (the sync tolerance).
-// With `frame_stats`, one row per frame after it was handed to the session.
-void MapBag(const rosbag::Bag& bag, const InputOptions& input, MappingSession* session,
-            ProgressMeter* progress, FrameStatsWriter* frame_stats, RunStats* stats) {
-  CameraInfoPairing pairing(
-      CameraInfoTable(CameraInfoTable::ToleranceFromFirstMessages(bag, input.camera_info_topic)),
-      input.sync == "exact");
-  SessionUpdate update;
-  // After each message: the first frame mapped is reported once.
-  const auto note_first_frame = [&] {
-    if (!stats->startup_s && !update.used.empty()) {
-      stats->startup_s = SecondsSinceProcessStart();
-      std::fprintf(stderr, "map_from_bag: first frame mapped after %.3f s\n", *stats->startup_s);
-    }
-    update.used.clear();
-    update.skipped.clear();
-  };
-  // After each frame (a mask message; `stamp` NaN when it did not deserialize).
-  const auto frame_done = [&](double stamp) {
-    if (frame_stats) frame_stats->Add(stats->frames_read, stamp);
-    progress->Update(++stats->frames_read);
-    note_first_frame();
-  };
-  std::vector<PairedMask> paired;
-  const auto add_paired = [&] {
-    for (const PairedMask& frame : paired) {
-      AddMask(frame, session, &update);
-      frame_done(ToSeconds(frame.mask->header.stamp));
-    }
-    paired.clear();
-  };
-  {
-    BagPrefetcher prefetcher(bag, {input.mask_topic, input.odom_topic, input.camera_info_topic});
-    BagPrefetcher::Item message;
-    while (prefetcher.Next(&message)) {
-      switch (message.kind) {
-        case BagPrefetcher::Kind::kOdometry:
-          session->AddOdometry(ToPose(message.odometry), &update);
-          note_first_frame();
-          break;
-        case BagPrefetcher::Kind::kCameraInfo:
-          // One that does not deserialize is left out (its mask reports no_camera_info).
-          if (message.camera_info) pairing.AddCameraInfo(*message.camera_info, &paired);
-          break;
-        case BagPrefetcher::Kind::kMask:
-          if (message.mask) {
-            pairing.AddMask(message.mask, &paired);
-          } else {
-            session->CountSkipped("bad_mask_message: not a sensor_msgs/Image", &update);
-            frame_done(std::numeric_limits<double>::quiet_NaN());
-          }
-          break;
-      }
-      add_paired();
-    }
-  }
-  pairing.Flush(&paired);
-  add_paired();
-  session->Finish(&update);  // waiting frames decided, the last window's solve merged
-  note_first_frame();
-}
-
 void WriteOutputs(const std::string& dir, const VectorMap& map,
                   const std::optional<GeoOrigin>& geo_origin, const std::string& summary) {
   SaveMapFiles(map, geo_origin, MapFilePathsInFolder(dir));
@@ -372,7 +278,16 @@ int Run(int argc, char** argv) {
 
   ProgressMeter progress(total_masks, "frames");
   const auto start = std::chrono::steady_clock::now();
-  MapBag(bag, input, &session, &progress, frame_stats ? &*frame_stats : nullptr, &stats);
+  BagMappingCallbacks callbacks;
+  callbacks.frame_done = [&](std::size_t frame, double stamp) {
+    if (frame_stats) frame_stats->Add(frame, stamp);
+    progress.Update(frame + 1);
+  };
+  callbacks.first_frame_mapped = [&stats] {
+    stats.startup_s = SecondsSinceProcessStart();
+    std::fprintf(stderr, "map_from_bag: first frame mapped after %.3f s\n", *stats.startup_s);
+  };
+  stats.frames_read = MapBag(bag, input, &session, callbacks);
   progress.Finish();
   stats.wall_s = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
   stats.bag_span_s = (span_view.getEndTime() - span_view.getBeginTime()).toSec();
