@@ -297,6 +297,8 @@ int Run(int argc, char** argv) {
   map.metadata["bag"] = args.bag;
   map.metadata["config"] = args.config;
   map.metadata["extrinsic_source"] = stats.extrinsic_source;
+  // Process start to the first frame mapped, s (null when none was).
+  map.metadata["startup_s"] = stats.startup_s ? nlohmann::json(*stats.startup_s) : nullptr;
   const std::string summary = Summary(args, mapper, session.assembler(), map, stats);
   try {
     if (frame_stats) frame_stats->Close();

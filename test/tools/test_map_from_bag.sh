@@ -256,7 +256,7 @@ if run_mapper --bag "$work/loop.bag" --config "$exact_config" --out "$work/stats
     --stats-out "$work/stats.csv" >/dev/null 2>"$work/stats.err"; then
   /usr/bin/python3 - "$work/stats.csv" "$work/stats/summary.txt" "$work/stats.err" <<'EOF' \
     && pass "--stats-out: 50 rows (25 used, 25 skipped), startup_s" || fail "--stats-out checks"
-import csv, re, sys
+import csv, json, re, sys
 rows = list(csv.reader(open(sys.argv[1])))
 assert rows[0] == ["frame", "stamp", "cpu_s", "rss_kb"], rows[0]
 rows = rows[1:]
@@ -272,6 +272,8 @@ assert all(int(r[3]) > 10000 for r in rows), "rss_kb"
 summary = open(sys.argv[2]).read()
 m = re.search(r"^startup_s: ([0-9.]+) ", summary, re.M)
 assert m and 0 < float(m.group(1)) < 60, "startup_s in the summary"
+meta = json.load(open(sys.argv[2].replace("summary.txt", "map.json")))["metadata"]
+assert abs(meta["startup_s"] - float(m.group(1))) < 1e-3, "map.json metadata startup_s"
 err = open(sys.argv[3]).read()
 assert re.search(r"^map_from_bag: first frame mapped after [0-9]+\.[0-9]{3} s$", err, re.M), err
 print(f"ok: {len(rows)} rows; cpu {cpu[0]:.3f} -> {cpu[-1]:.3f} s; startup_s {m.group(1)}")
