@@ -4,14 +4,24 @@
 #include <rosbag/view.h>
 
 #include <utility>
+#include <vector>
 
 namespace ipm_road_mapper {
+namespace {
 
-BagPrefetcher::BagPrefetcher(const rosbag::Bag& bag, const std::string& mask_topic,
-                             const std::string& odom_topic, std::size_t capacity)
+// The message as M when the bag says it is one (instantiate() would deserialize another
+// type's bytes), else null.
+template <class M>
+boost::shared_ptr<const M> InstantiateIf(const rosbag::MessageInstance& message) {
+  if (message.getDataType() != ros::message_traits::DataType<M>::value()) return nullptr;
+  return message.instantiate<M>();
+}
+
+}  // namespace
+
+BagPrefetcher::BagPrefetcher(const rosbag::Bag& bag, const Topics& topics, std::size_t capacity)
     : capacity_(capacity < 1 ? 1 : capacity) {
-  reader_ =
-      std::thread([this, &bag, mask_topic, odom_topic] { Read(bag, mask_topic, odom_topic); });
+  reader_ = std::thread([this, &bag, topics] { Read(bag, topics); });
 }
 
 BagPrefetcher::~BagPrefetcher() {
@@ -23,29 +33,42 @@ BagPrefetcher::~BagPrefetcher() {
   reader_.join();
 }
 
-void BagPrefetcher::Read(const rosbag::Bag& bag, const std::string& mask_topic,
-                         const std::string& odom_topic) {
+BagPrefetcher::Item BagPrefetcher::Deserialize(const rosbag::MessageInstance& message,
+                                               const Topics& topics) {
+  Item item;
+  const std::string& topic = message.getTopic();
+  item.kind = topic == topics.mask       ? Kind::kMask
+              : topic == topics.odometry ? Kind::kOdometry
+                                         : Kind::kCameraInfo;
+  // A message that does not deserialize (truncated, or written under another type's
+  // connection) is handed on as null too, and reading goes on.
   try {
-    rosbag::View view(bag, rosbag::TopicQuery({mask_topic, odom_topic}));
+    switch (item.kind) {
+      case Kind::kMask:
+        item.mask = InstantiateIf<sensor_msgs::Image>(message);
+        break;
+      case Kind::kOdometry:
+        item.odometry = InstantiateIf<nav_msgs::Odometry>(message);
+        break;
+      case Kind::kCameraInfo:
+        item.camera_info = InstantiateIf<sensor_msgs::CameraInfo>(message);
+        break;
+    }
+  } catch (const ros::serialization::StreamOverrunException&) {
+    item.mask.reset();
+    item.odometry.reset();
+    item.camera_info.reset();
+  }
+  return item;
+}
+
+void BagPrefetcher::Read(const rosbag::Bag& bag, const Topics& topics) {
+  try {
+    std::vector<std::string> names = {topics.mask, topics.odometry};
+    if (!topics.camera_info.empty()) names.push_back(topics.camera_info);
+    rosbag::View view(bag, rosbag::TopicQuery(names));
     for (const rosbag::MessageInstance& message : view) {
-      Item item;
-      item.is_mask = message.getTopic() == mask_topic;
-      // The type is checked first (instantiate() would deserialize another type's bytes);
-      // a message that does not deserialize (truncated, or written under another type's
-      // connection) is handed on as null too, and reading goes on.
-      try {
-        if (item.is_mask) {
-          if (message.getDataType() == ros::message_traits::DataType<sensor_msgs::Image>::value()) {
-            item.mask = message.instantiate<sensor_msgs::Image>();
-          }
-        } else if (message.getDataType() ==
-                   ros::message_traits::DataType<nav_msgs::Odometry>::value()) {
-          item.odometry = message.instantiate<nav_msgs::Odometry>();
-        }
-      } catch (const ros::serialization::StreamOverrunException&) {
-        item.mask.reset();
-        item.odometry.reset();
-      }
+      Item item = Deserialize(message, topics);
       std::unique_lock<std::mutex> lock(mutex_);
       not_full_.wait(lock, [this] { return stopping_ || queue_.size() < capacity_; });
       if (stopping_) return;

@@ -6,7 +6,8 @@
 //
 // Writes <dir>/drive.bag (/camera/camera_info, /camera/instances, /camera/image_raw, /odom,
 // /tf_static), <dir>/ground_truth.json, <dir>/trajectory_true_tum.txt and
-// <dir>/trajectory_odom_tum.txt, and prints a summary. Bad input: one error line, exit 2.
+// <dir>/trajectory_odom_tum.txt, and prints a summary. --help lists the options (exit 0).
+// Bad input (command line included): one error line, exit 2.
 #include <nav_msgs/Odometry.h>
 #include <ros/package.h>
 #include <rosbag/bag.h>
@@ -20,24 +21,21 @@
 #include <cstring>
 #include <filesystem>
 #include <iostream>
-#include <map>
+#include <optional>
 #include <string>
 
 #include "ipm_road_mapper/core/io/ground_truth.h"
+#include "ipm_road_mapper/core/map/vector_map.h"
+#include "ipm_road_mapper/pipeline/command_line.h"
 #include "ipm_road_mapper/sim/drive_simulator.h"
 #include "ipm_road_mapper/sim/ipm_check.h"
-#include "ipm_road_mapper/core/map/vector_map.h"
 
 namespace irm = ipm_road_mapper;
 namespace fs = std::filesystem;
 
 namespace {
 
-constexpr const char* kUsage =
-    "usage: generate_drive --scenario <yaml> --seed <n> --out <dir> [--classes <yaml>] "
-    "[--max-frames <n>]";
-
-// A usage or input error: reported as one line, exit code 2.
+// An input error (the command line is checked by CommandLine): one line, exit code 2.
 struct InputError : std::runtime_error {
   using std::runtime_error::runtime_error;
 };
@@ -48,51 +46,34 @@ struct Arguments {
   int max_frames = 0;
 };
 
-long ParseInteger(const std::string& flag, const std::string& text, long lo, long hi) {
-  char* end = nullptr;
-  const long value = std::strtol(text.c_str(), &end, 10);
-  if (text.empty() || *end != '\0' || value < lo || value > hi) {
-    throw InputError(flag + ": expected an integer in [" + std::to_string(lo) + ", " +
-                     std::to_string(hi) + "], got '" + text + "'");
-  }
-  return value;
+// Parses the command line (pipeline/command_line.h): the exit code when the tool stops
+// there (--help: 0, a bad command line: 2), else nullopt with *a filled in.
+std::optional<int> ParseArguments(int argc, char** argv, Arguments* a) {
+  std::int64_t seed = 0, max_frames = 0;
+  irm::CommandLine line("generate_drive",
+                        "Renders a synthetic drive (docs/synthetic_drives.md) into <out>/drive.bag "
+                        "plus its ground truth and TUM trajectories.");
+  line.Required("scenario", "<yaml>", &a->scenario, "scenario file (config/scenarios/*.yaml)")
+      .Integer("seed", "<n>", &seed, 0, 4294967295LL, true, "", "random seed (noise, odometry)")
+      .Required("out", "<dir>", &a->out, "output folder (created if needed)")
+      .Optional("classes", "<yaml>", &a->classes,
+                "classes.yaml beside the scenario's folder, else the package's "
+                "config/classes.yaml",
+                "class table")
+      .Integer("max-frames", "<n>", &max_frames, 1, 1000000, false, "every frame of the scenario",
+               "render at most this many frames");
+  if (const std::optional<int> exit_code = line.ParseOrExitCode(argc, argv)) return exit_code;
+  a->seed = static_cast<std::uint32_t>(seed);
+  a->max_frames = static_cast<int>(max_frames);
+  return std::nullopt;
 }
 
-Arguments ParseArguments(int argc, char** argv) {
-  std::map<std::string, std::string> flags;
-  for (int i = 1; i < argc; ++i) {
-    const std::string flag = argv[i];
-    if (flag != "--scenario" && flag != "--seed" && flag != "--out" && flag != "--classes" &&
-        flag != "--max-frames") {
-      throw InputError("unknown argument '" + flag + "'; " + kUsage);
-    }
-    if (i + 1 >= argc) throw InputError(flag + ": missing value; " + kUsage);
-    flags[flag] = argv[++i];
-  }
-  for (const char* required : {"--scenario", "--seed", "--out"}) {
-    if (!flags.count(required))
-      throw InputError(std::string("missing ") + required + "; " + kUsage);
-  }
-  Arguments a;
-  a.scenario = flags["--scenario"];
-  a.out = flags["--out"];
-  a.seed = static_cast<std::uint32_t>(ParseInteger("--seed", flags["--seed"], 0, 4294967295L));
-  if (flags.count("--max-frames")) {
-    a.max_frames =
-        static_cast<int>(ParseInteger("--max-frames", flags["--max-frames"], 1, 1000000));
-  }
-  if (flags.count("--classes")) {
-    a.classes = flags["--classes"];
-  } else {
-    // The package's class table: beside the scenario folder (config/scenarios/..), else the
-    // installed package's config/.
-    const fs::path beside = fs::path(a.scenario).parent_path().parent_path() / "classes.yaml";
-    a.classes = fs::exists(beside)
-                    ? beside.string()
-                    : ros::package::getPath("ipm_road_mapper") + "/config/classes.yaml";
-  }
-  if (!fs::is_regular_file(a.scenario)) throw InputError(a.scenario + ": no such scenario file");
-  return a;
+// The class table when --classes is not given: beside the scenario folder
+// (config/scenarios/..), else the installed package's config/.
+std::string DefaultClassesFile(const std::string& scenario) {
+  const fs::path beside = fs::path(scenario).parent_path().parent_path() / "classes.yaml";
+  return fs::exists(beside) ? beside.string()
+                            : ros::package::getPath("ipm_road_mapper") + "/config/classes.yaml";
 }
 
 ros::Time ToRosTime(std::int64_t stamp_ns) {
@@ -279,8 +260,14 @@ int Run(const Arguments& args) {
 }  // namespace
 
 int main(int argc, char** argv) {
+  Arguments args;
+  if (const std::optional<int> exit_code = ParseArguments(argc, argv, &args)) return *exit_code;
   try {
-    return Run(ParseArguments(argc, argv));
+    if (args.classes.empty()) args.classes = DefaultClassesFile(args.scenario);
+    if (!fs::is_regular_file(args.scenario)) {
+      throw InputError(args.scenario + ": no such scenario file");
+    }
+    return Run(args);
   } catch (const InputError& e) {
     std::cerr << "generate_drive: error: " << e.what() << std::endl;
   } catch (const irm::OptionsError& e) {

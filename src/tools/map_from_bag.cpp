@@ -1,28 +1,30 @@
 // Offline runner: builds the vector map from a bag file, without a roscore.
 //
 //   rosrun ipm_road_mapper map_from_bag --bag <bag> [--config <yaml>] [--classes <yaml>]
-//                                       [--async] --out <dir>
+//                                       [--async] --out <dir> [--stats-out <csv>]
 //
 // The back end solves every window in turn (backend.synchronous forced on: offline the bag
 // is read far faster than real time, and an owned optimizer thread would drop most
 // windows); --async keeps the config's threading, as the nodelet runs it.
 //
 // Reads the mask, camera_info and odometry topics of the config's `input` section with the
-// rosbag C++ API (masks and odometry read ahead in a thread: BagPrefetcher), pairs each mask with
-// its camera_info (sync exact: identical stamp; approximate: nearest within half a frame period)
-// and with odometry interpolated at its stamp (FrameAssembler, the same code the nodelet uses),
-// runs the core Mapper, and writes <dir>/map.json, <dir>/map.geojson, <dir>/trajectory_tum.txt and
-// <dir>/summary.txt. The rough extrinsic T_base_cam is the config's input.extrinsic when given,
-// else the bag's /tf_static transform from input.base_frame to the mask's header.frame_id (a chain
-// of static transforms is composed). Defaults: --config and --classes are config/mapper.yaml and
+// rosbag C++ API in one pass (read ahead in a thread: BagPrefetcher; mapping starts with the
+// first messages), pairs each mask with its camera_info (CameraInfoPairing; sync exact:
+// identical stamp; approximate: nearest within half the period of the first camera_infos)
+// and with odometry interpolated at its stamp (FrameAssembler, the same code the nodelet
+// uses), runs the core Mapper, and writes <dir>/map.json, <dir>/map.geojson,
+// <dir>/trajectory_tum.txt and <dir>/summary.txt (with startup_s: process start to the first
+// frame mapped), and with --stats-out a CSV row per frame (CPU time, RSS). The rough
+// extrinsic T_base_cam is the config's input.extrinsic when given, else the bag's /tf_static
+// transform from input.base_frame to the mask's header.frame_id (a chain of static transforms
+// is composed). Defaults: --config and --classes are config/mapper.yaml and
 // config/classes.yaml of the package, found by rospack (ROS_PACKAGE_PATH), else under
-// $IRM_SOURCE_DIR, else in the install space next to the executable (../../share/ipm_road_mapper).
-// Exit status: 0 done; 2 bad input (missing bag, bad config, missing topic, no extrinsic, ...)
-// with one error line on stderr; 1 an output could not be written.
-#include <nav_msgs/Odometry.h>
+// $IRM_SOURCE_DIR, else in the install space next to the executable
+// (../../share/ipm_road_mapper). Exit status: 0 done (or --help); 2 bad input (bad command
+// line, missing bag, bad config, missing topic, no extrinsic, ...) with one error line on
+// stderr; 1 an output could not be written.
 #include <ros/package.h>
 #include <rosbag/view.h>
-#include <sensor_msgs/CameraInfo.h>
 #include <sensor_msgs/Image.h>
 
 #include <chrono>
@@ -32,34 +34,30 @@
 #include <filesystem>
 #include <fstream>
 #include <iostream>
-#include <limits>
 #include <optional>
 #include <sstream>
 #include <stdexcept>
 #include <string>
 
-#include "ipm_road_mapper/pipeline/frame_assembler.h"
-#include "ipm_road_mapper/core/io/geojson_export.h"
-#include "ipm_road_mapper/core/mapper/mapper.h"
 #include "ipm_road_mapper/core/geometry/rigid_transform.h"
+#include "ipm_road_mapper/core/io/geojson_export.h"
 #include "ipm_road_mapper/core/map/vector_map.h"
-#include "ipm_road_mapper/ros/bag_input.h"
-#include "ipm_road_mapper/ros/bag_prefetcher.h"
+#include "ipm_road_mapper/core/mapper/mapper.h"
+#include "ipm_road_mapper/pipeline/command_line.h"
 #include "ipm_road_mapper/pipeline/extrinsic_source.h"
+#include "ipm_road_mapper/pipeline/frame_assembler.h"
 #include "ipm_road_mapper/pipeline/map_files.h"
 #include "ipm_road_mapper/pipeline/mapper_config.h"
 #include "ipm_road_mapper/pipeline/mapping_session.h"
-#include "ipm_road_mapper/ros/msg_conversion.h"
+#include "ipm_road_mapper/pipeline/process_stats.h"
 #include "ipm_road_mapper/pipeline/progress_meter.h"
+#include "ipm_road_mapper/ros/bag_input.h"
+#include "ipm_road_mapper/ros/bag_mapping.h"
 
 namespace ipm_road_mapper {
 namespace {
 
 namespace fs = std::filesystem;
-
-constexpr const char* kUsage =
-    "usage: map_from_bag --bag <bag> [--config <mapper.yaml>] [--classes <classes.yaml>] "
-    "[--async] --out <dir>";
 
 // Bad input: reported as one line, exit status 2.
 struct InputError : std::runtime_error {
@@ -68,7 +66,8 @@ struct InputError : std::runtime_error {
 
 struct Arguments {
   std::string bag, config, classes, out;
-  bool async = false;  // keep backend.synchronous as configured (live-like timing)
+  std::string stats_out;  // empty: no per-frame stats file
+  bool async = false;     // keep backend.synchronous as configured (live-like timing)
 };
 
 // A file of the package (e.g. "config/mapper.yaml"); see the file comment for the search.
@@ -80,31 +79,24 @@ std::string PackageFile(const std::string& relative) {
   }
 }
 
-Arguments ParseArguments(int argc, char** argv) {
-  Arguments args;
-  for (int i = 1; i < argc; ++i) {
-    const std::string flag = argv[i];
-    if (flag == "--async") {
-      args.async = true;
-      continue;
-    }
-    if (flag == "-h" || flag == "--help") {
-      std::cout << kUsage << "\n";
-      std::exit(0);
-    }
-    std::string* target = flag == "--bag"       ? &args.bag
-                          : flag == "--config"  ? &args.config
-                          : flag == "--classes" ? &args.classes
-                          : flag == "--out"     ? &args.out
-                                                : nullptr;
-    if (!target) throw InputError("unknown argument '" + flag + "'; " + kUsage);
-    if (i + 1 >= argc) throw InputError(flag + " needs a value; " + kUsage);
-    *target = argv[++i];
-  }
-  if (args.bag.empty() || args.out.empty()) throw InputError(std::string(kUsage));
-  if (args.config.empty()) args.config = PackageFile("config/mapper.yaml");
-  if (args.classes.empty()) args.classes = PackageFile("config/classes.yaml");
-  return args;
+// Parses the command line (pipeline/command_line.h): the exit code when the tool stops
+// there (--help: 0, a bad command line: 2), else nullopt with *args filled in.
+std::optional<int> ParseArguments(int argc, char** argv, Arguments* args) {
+  CommandLine line("map_from_bag",
+                   "Builds the vector map from a bag file, without a roscore "
+                   "(docs/map_from_bag.md).");
+  line.Required("bag", "<bag>", &args->bag, "the bag to map")
+      .Optional("config", "<mapper.yaml>", &args->config, "config/mapper.yaml of the package",
+                "mapper config (may start with `base: <file>`)")
+      .Optional("classes", "<classes.yaml>", &args->classes, "config/classes.yaml of the package",
+                "mask class table")
+      .Flag("async", &args->async,
+            "keep the config's back-end threading (as live) instead of solving every window "
+            "in turn")
+      .Required("out", "<dir>", &args->out, "output folder (created if needed)")
+      .Optional("stats-out", "<file>", &args->stats_out, "none",
+                "per-frame CSV frame,stamp,cpu_s,rss_kb (docs/map_from_bag.md)");
+  return line.ParseOrExitCode(argc, argv);
 }
 
 // Loads the config (mapper options, geo_origin, the nodelet's `ros` section: the same loader
@@ -145,6 +137,7 @@ struct RunStats {
   std::size_t frames_read = 0;
   double bag_span_s = 0.0;
   double wall_s = 0.0;
+  std::optional<double> startup_s;  // process start to the first frame mapped
   std::string extrinsic_source;
 };
 
@@ -179,6 +172,14 @@ std::string FrontEndLine(const Mapper& mapper) {
   return s.str();
 }
 
+// Seconds with 3 decimals, or "none" when no frame was mapped.
+std::string StartupText(const std::optional<double>& startup_s) {
+  if (!startup_s) return "none";
+  char text[32];
+  std::snprintf(text, sizeof(text), "%.3f", *startup_s);
+  return text;
+}
+
 std::string Summary(const Arguments& args, const Mapper& mapper, const FrameAssembler& assembler,
                     const VectorMap& map, const RunStats& stats) {
   const MapperCounters& c = mapper.counters();
@@ -205,30 +206,15 @@ std::string Summary(const Arguments& args, const Mapper& mapper, const FrameAsse
     << c.lane_observations_unused << ", near a lane " << c.lane_observations_near_lane << ")\n"
     << BackendLine(mapper) << "\n"
     << FrontEndLine(mapper) << "\n"
+    << "startup_s: " << StartupText(stats.startup_s)
+    << " (process start to the first frame mapped)\n"
     << "wall time: " << stats.wall_s << " s; "
     << (stats.wall_s > 0 ? stats.frames_read / stats.wall_s : 0.0) << " frames/s; bag span "
     << stats.bag_span_s << " s; real-time factor "
     << (stats.wall_s > 0 ? stats.bag_span_s / stats.wall_s : 0.0) << "x\n"
-    << "outputs: " << args.out << "/{map.json, map.geojson, trajectory_tum.txt, summary.txt}\n";
+    << "outputs: " << args.out << "/{map.json, map.geojson, trajectory_tum.txt, summary.txt}"
+    << (args.stats_out.empty() ? "" : ", " + args.stats_out) << "\n";
   return s.str();
-}
-
-// Hands a mask message to the session, or counts why it cannot be a frame.
-void AddMask(const sensor_msgs::Image& msg, const CameraInfoTable& camera_infos, bool exact_sync,
-             MappingSession* session) {
-  cv::Mat mask;
-  std::string error = ImageToMask(msg, &mask);
-  if (!error.empty()) {
-    session->CountSkipped("bad_mask_encoding: " + error, nullptr);
-    return;
-  }
-  CameraIntrinsics camera;
-  error = camera_infos.Match(msg.header.stamp, exact_sync, &camera);
-  if (!error.empty()) {
-    session->CountSkipped(error, nullptr);
-    return;
-  }
-  session->AddFrame(ToSeconds(msg.header.stamp), std::move(mask), camera, nullptr);
 }
 
 void WriteOutputs(const std::string& dir, const VectorMap& map,
@@ -240,7 +226,10 @@ void WriteOutputs(const std::string& dir, const VectorMap& map,
 }
 
 int Run(int argc, char** argv) {
-  const Arguments args = ParseArguments(argc, argv);
+  Arguments args;
+  if (const std::optional<int> exit_code = ParseArguments(argc, argv, &args)) return *exit_code;
+  if (args.config.empty()) args.config = PackageFile("config/mapper.yaml");
+  if (args.classes.empty()) args.classes = PackageFile("config/classes.yaml");
   MapperConfig config = LoadConfig(args.config);
   // Offline, every window is solved in turn (the bag is read far faster than real time, so
   // an owned thread would drop most of them); --async keeps the config's threading.
@@ -272,43 +261,33 @@ int Run(int argc, char** argv) {
   if (dir_error || !fs::is_directory(args.out)) {
     throw InputError(args.out + ": cannot create output folder: " + dir_error.message());
   }
+  // Opened before mapping, so an unwritable path fails at once (exit 1).
+  std::optional<FrameStatsWriter> frame_stats;
+  if (!args.stats_out.empty()) frame_stats.emplace(args.stats_out);
 
-  const CameraInfoTable camera_infos = CameraInfoTable::Read(bag, input.camera_info_topic);
-  const bool exact_sync = input.sync == "exact";
   // The same pipeline as the nodelet's; no odometry wait rule offline (the bag is complete).
   MappingSession session(options, classes);
   session.Start(T_base_cam);
+  // Counts and span from the bag's index (no message is read).
   rosbag::View span_view(bag, rosbag::TopicQuery({input.mask_topic, input.odom_topic}));
   const std::size_t total_masks = rosbag::View(bag, rosbag::TopicQuery(input.mask_topic)).size();
-  std::cerr << "map_from_bag: " << total_masks << " masks, " << camera_infos.size()
+  const std::size_t total_camera_infos =
+      rosbag::View(bag, rosbag::TopicQuery(input.camera_info_topic)).size();
+  std::cerr << "map_from_bag: " << total_masks << " masks, " << total_camera_infos
             << " camera_infos; extrinsic from " << stats.extrinsic_source << "\n";
 
   ProgressMeter progress(total_masks, "frames");
   const auto start = std::chrono::steady_clock::now();
-  {
-    // The bag is read and deserialized ahead, in its own thread; mapping stays in this one.
-    BagPrefetcher prefetcher(bag, input.mask_topic, input.odom_topic);
-    BagPrefetcher::Item message;
-    while (prefetcher.Next(&message)) {
-      if (!message.is_mask) {
-        StampedPose pose;
-        // An unconvertible message (e.g. a zero quaternion) is handed on as a NaN pose, so
-        // the assembler counts it as bad_odometry like any other invalid pose.
-        if (!message.odometry || !OdometryToStampedPose(*message.odometry, &pose).empty()) {
-          pose.T_map_base.matrix().setConstant(std::numeric_limits<double>::quiet_NaN());
-        }
-        session.AddOdometry(pose, nullptr);
-      } else {
-        if (message.mask) {
-          AddMask(*message.mask, camera_infos, exact_sync, &session);
-        } else {
-          session.CountSkipped("bad_mask_message: not a sensor_msgs/Image", nullptr);
-        }
-        progress.Update(++stats.frames_read);
-      }
-    }
-  }
-  session.Finish(nullptr);  // waiting frames decided, the last window's solve merged
+  BagMappingCallbacks callbacks;
+  callbacks.frame_done = [&](std::size_t frame, double stamp) {
+    if (frame_stats) frame_stats->Add(frame, stamp);
+    progress.Update(frame + 1);
+  };
+  callbacks.first_frame_mapped = [&stats] {
+    stats.startup_s = SecondsSinceProcessStart();
+    std::fprintf(stderr, "map_from_bag: first frame mapped after %.3f s\n", *stats.startup_s);
+  };
+  stats.frames_read = MapBag(bag, input, &session, callbacks);
   progress.Finish();
   stats.wall_s = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
   stats.bag_span_s = (span_view.getEndTime() - span_view.getBeginTime()).toSec();
@@ -318,8 +297,11 @@ int Run(int argc, char** argv) {
   map.metadata["bag"] = args.bag;
   map.metadata["config"] = args.config;
   map.metadata["extrinsic_source"] = stats.extrinsic_source;
+  // Process start to the first frame mapped, s (null when none was).
+  map.metadata["startup_s"] = stats.startup_s ? nlohmann::json(*stats.startup_s) : nullptr;
   const std::string summary = Summary(args, mapper, session.assembler(), map, stats);
   try {
+    if (frame_stats) frame_stats->Close();
     WriteOutputs(args.out, map, config.geo_origin, summary);
   } catch (const std::exception& e) {
     std::cerr << "map_from_bag: error: " << e.what() << "\n";

@@ -1,6 +1,5 @@
-// Bag input helpers: topic checks, the extrinsic from a chain of /tf_static transforms, and
-// camera_info <-> mask pairing (exact by ros::Time, approximate within half a period), on
-// small bags written here.
+// Bag input helpers: topic checks and the extrinsic from a chain of /tf_static transforms, on
+// a small bag written here (camera_info <-> mask pairing: test_bag_camera_info.cpp).
 #include <gtest/gtest.h>
 #include <rosbag/bag.h>
 #include <stdlib.h>
@@ -91,45 +90,6 @@ TEST_F(BagInputTest, MissingStaticTransform) {
   Eigen::Isometry3d T;
   const std::string error = LookupStaticTransform(bag_, "base_link", "lidar", &T);
   EXPECT_NE(error.find("no transform base_link -> lidar"), std::string::npos) << error;
-}
-
-TEST_F(BagInputTest, ExactSyncComparesRosTime) {
-  const CameraInfoTable table = CameraInfoTable::Read(bag_, "/camera/camera_info");
-  ASSERT_EQ(table.size(), 10u);
-  EXPECT_NEAR(table.approximate_tolerance_s(), 0.05, 1e-6);
-  CameraIntrinsics intrinsics;
-  const ros::Time stamp3 = ros::Time(kT0) + ros::Duration(0.3);
-  ASSERT_EQ(table.Match(stamp3, /*exact=*/true, &intrinsics), "");
-  EXPECT_EQ(intrinsics.width, 640);
-  // One nanosecond off is not exact.
-  const std::string off = table.Match(stamp3 + ros::Duration(0, 1), true, &intrinsics);
-  EXPECT_EQ(off.rfind("no_camera_info: ", 0), 0u) << off;
-}
-
-TEST_F(BagInputTest, ApproximateSyncWithinHalfAPeriod) {
-  const CameraInfoTable table = CameraInfoTable::Read(bag_, "/camera/camera_info");
-  CameraIntrinsics intrinsics;
-  const ros::Time stamp3 = ros::Time(kT0) + ros::Duration(0.3);
-  EXPECT_EQ(table.Match(stamp3 + ros::Duration(0.04), false, &intrinsics), "");
-  EXPECT_EQ(table.Match(stamp3 - ros::Duration(0.04), false, &intrinsics), "");
-  // Beyond the last camera_info by more than half a period.
-  const std::string late = table.Match(ros::Time(kT0 + 1.5), false, &intrinsics);
-  EXPECT_EQ(late.rfind("no_camera_info: ", 0), 0u) << late;
-}
-
-TEST_F(BagInputTest, UnsupportedCameraInfoIsReportedForItsFrame) {
-  const CameraInfoTable table = CameraInfoTable::Read(bag_, "/camera/camera_info");
-  CameraIntrinsics intrinsics;
-  const std::string error = table.Match(ros::Time(kT0) + ros::Duration(0.7), true, &intrinsics);
-  EXPECT_EQ(error.rfind("bad_camera_info: ", 0), 0u) << error;
-  EXPECT_NE(error.find("equidistant"), std::string::npos) << error;
-}
-
-TEST(CameraInfoTableTest, EmptyTopic) {
-  CameraInfoTable table;
-  CameraIntrinsics intrinsics;
-  EXPECT_EQ(table.Match(ros::Time(1.0), true, &intrinsics),
-            "no_camera_info: no camera_info in the bag");
 }
 
 }  // namespace

@@ -1,6 +1,7 @@
-// BagPrefetcher: every mask and odometry message in bag order with the right payload,
-// other topics left out, a message that does not deserialize handed on as null, a queue far smaller
-// than the bag, and a consumer that stops early (the reader is joined without a hang).
+// BagPrefetcher: every mask, odometry and camera_info message in bag order with the right
+// payload, other topics (and camera_info when not asked for) left out, a message that does not
+// deserialize handed on as null, a queue far smaller than the bag, and a consumer that stops early
+// (the reader is joined without a hang).
 #include <gtest/gtest.h>
 #include <rosbag/bag.h>
 #include <std_msgs/String.h>
@@ -41,6 +42,12 @@ class BagPrefetcherTest : public ::testing::Test {
       mask.step = 16;
       mask.data.assign(64, static_cast<std::uint8_t>(k));
       bag.write("/camera/instances", t, mask);
+      if (k % 2 == 0) {
+        sensor_msgs::CameraInfo info;
+        info.header.stamp = t;
+        info.width = 8 + k;
+        bag.write("/camera/camera_info", t + ros::Duration(0.001), info);  // after its mask
+      }
       std_msgs::String other;
       other.data = "not read";
       bag.write("/other", t, other);
@@ -63,20 +70,22 @@ class BagPrefetcherTest : public ::testing::Test {
 };
 
 TEST_F(BagPrefetcherTest, DeliversMasksAndOdometryInBagOrder) {
-  BagPrefetcher prefetcher(bag_, "/camera/instances", "/odom", 3);
+  BagPrefetcher prefetcher(bag_, {"/camera/instances", "/odom", ""}, 3);
   BagPrefetcher::Item item;
   int masks = 0, odometry = 0, nulls = 0;
   double last_stamp = 0.0;
   while (prefetcher.Next(&item)) {
-    if (item.is_mask ? !item.mask : !item.odometry) {
+    ASSERT_NE(item.kind, BagPrefetcher::Kind::kCameraInfo) << "camera_info was not asked for";
+    const bool is_mask = item.kind == BagPrefetcher::Kind::kMask;
+    if (is_mask ? !item.mask : !item.odometry) {
       ++nulls;
       continue;
     }
     const double stamp =
-        item.is_mask ? item.mask->header.stamp.toSec() : item.odometry->header.stamp.toSec();
+        is_mask ? item.mask->header.stamp.toSec() : item.odometry->header.stamp.toSec();
     EXPECT_GE(stamp, last_stamp);
     last_stamp = stamp;
-    if (item.is_mask) {
+    if (is_mask) {
       ASSERT_EQ(item.mask->data.size(), 64u);
       EXPECT_EQ(item.mask->data[10], masks);
       ++masks;
@@ -91,9 +100,29 @@ TEST_F(BagPrefetcherTest, DeliversMasksAndOdometryInBagOrder) {
   EXPECT_FALSE(prefetcher.Next(&item));  // stays at the end
 }
 
+TEST_F(BagPrefetcherTest, DeliversCameraInfoInBagOrderWhenAskedFor) {
+  BagPrefetcher prefetcher(bag_, {"/camera/instances", "/odom", "/camera/camera_info"}, 3);
+  BagPrefetcher::Item item;
+  int masks = 0, odometry = 0, camera_infos = 0;
+  while (prefetcher.Next(&item)) {
+    masks += item.kind == BagPrefetcher::Kind::kMask && item.mask;
+    odometry += item.kind == BagPrefetcher::Kind::kOdometry && item.odometry;
+    if (item.kind != BagPrefetcher::Kind::kCameraInfo) continue;
+    ASSERT_TRUE(item.camera_info);
+    EXPECT_FALSE(item.mask || item.odometry);
+    // Every second frame has one, written right after its mask.
+    EXPECT_EQ(masks, 2 * camera_infos + 1);
+    EXPECT_EQ(item.camera_info->width, 8u + 2 * camera_infos);
+    ++camera_infos;
+  }
+  EXPECT_EQ(masks, 100);
+  EXPECT_EQ(odometry, 100);
+  EXPECT_EQ(camera_infos, 50);
+}
+
 TEST_F(BagPrefetcherTest, StopsCleanlyWhenTheConsumerLeavesEarly) {
   for (int repeat = 0; repeat < 20; ++repeat) {
-    BagPrefetcher prefetcher(bag_, "/camera/instances", "/odom", 2);
+    BagPrefetcher prefetcher(bag_, {"/camera/instances", "/odom", "/camera/camera_info"}, 2);
     BagPrefetcher::Item item;
     ASSERT_TRUE(prefetcher.Next(&item));
   }  // each destructor joins a reader blocked on the full queue

@@ -221,6 +221,18 @@ expect_bad_input "wrong version" --map "$work/v7.json" --ground-truth "$work/gt.
 expect_bad_input "map as ground truth" --map "$work/map.json" --ground-truth "$work/map.json"
 expect_bad_input "unknown option" --map "$work/map.json" --ground-truth "$work/gt.json" --fast
 expect_bad_input "missing option" --map "$work/map.json"
+expect_bad_input "option twice" --map "$work/map.json" --map "$work/map.json" \
+  --ground-truth "$work/gt.json"
+
+# ---- The command line: --help names every option with its default, exit 0 ----------------
+evaluate_map --help >"$work/help.txt" 2>"$work/help.err" || fail "--help exited $?"
+[ ! -s "$work/help.err" ] || fail "--help wrote to stderr: $(cat "$work/help.err")"
+for option in --map --ground-truth --json --map-bytes --help; do
+  grep -q -- "$option" "$work/help.txt" || fail "--help does not name $option"
+done
+[ "$(grep -o -e "(default: " -e "(required)" "$work/help.txt" | wc -l)" -ge 4 ] ||
+  fail "--help does not give every option's default: $(cat "$work/help.txt")"
+echo "ok: --help names every option"
 expect_bad_input "bad byte count" --map "$work/map.json" --ground-truth "$work/gt.json" \
   --map-bytes -5
 

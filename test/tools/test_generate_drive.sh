@@ -1,7 +1,7 @@
 #!/usr/bin/env bash
 # End-to-end test of generate_drive: a short drive of the default scenario gives a bag with
 # the five topics in the documented conventions and a parseable, deterministic ground truth;
-# bad input gives exit code 2 and one error line. Runs in the devel space's environment
+# bad input gives exit code 2 and one error line; --help lists every option. Runs in the devel space's environment
 # (ctest) or by hand after `source <devel>/setup.bash`.
 set -eo pipefail
 
@@ -116,5 +116,19 @@ expect_input_error "bad value" "road.lanes" \
   --scenario "$work/bad_value.yaml" --seed 1 --out "$work/x" --classes "$classes"
 expect_input_error "missing argument" "missing --out" --scenario "$scenario" --seed 1
 expect_input_error "bad seed" "seed" --scenario "$scenario" --seed x1 --out "$work/x"
+expect_input_error "unknown option" "unknown argument '--fast'" \
+  --scenario "$scenario" --seed 1 --out "$work/x" --fast
+expect_input_error "bad --max-frames" "max-frames" \
+  --scenario "$scenario" --seed 1 --out "$work/x" --max-frames 0
 [ ! -e "$work/x" ] || fail "an output folder was created for bad input"
+
+# --- The command line: --help names every option with its default, exit 0 -----------------
+generate_drive --help > "$work/help.txt" 2> "$work/help.err" || fail "--help exited $?"
+[ ! -s "$work/help.err" ] || fail "--help wrote to stderr: $(cat "$work/help.err")"
+for option in --scenario --seed --out --classes --max-frames --help; do
+  grep -q -- "$option" "$work/help.txt" || fail "--help does not name $option"
+done
+[ "$(grep -o -e "(default: " -e "(required)" "$work/help.txt" | wc -l)" -ge 5 ] ||
+  fail "--help does not give every option's default: $(cat "$work/help.txt")"
+echo "ok: --help names every option"
 echo "PASS"

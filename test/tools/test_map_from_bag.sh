@@ -4,7 +4,8 @@
 # ground truth put it, the GeoJSON is accepted by a standard reader (python3-geojson and
 # python3-shapely when installed; the structure is always checked by hand too), the
 # extrinsic comes from /tf_static or the config, approximate sync pairs shifted
-# camera_infos, a bag loop is counted, and every kind of bad input exits 2 with one line.
+# camera_infos, a bag loop is counted, every kind of bad input exits 2 with one line, --help
+# lists every option, and --stats-out writes one row per frame.
 # Run by ctest in the devel space's environment (IRM_SOURCE_DIR = the repository).
 set -eo pipefail
 export PATH="/usr/bin:/bin:$PATH"
@@ -226,6 +227,68 @@ expect_input_error "no extrinsic" "no extrinsic" --bag "$work/no_tf.bag" --out "
 echo "not a bag" >"$work/garbage.bag"
 expect_input_error "not a bag" "garbage.bag" --bag "$work/garbage.bag" --out "$work/x"
 expect_input_error "missing classes" "nope.yaml" --bag "$work/drive.bag" --classes "$work/nope.yaml" --out "$work/x"
+
+# 7. The command line: --help names every option with its default and exits 0; an unknown
+# option exits 2 (above), and so does an abbreviated one.
+help_rc=0
+run_mapper --help >"$work/help.txt" 2>"$work/help.err" || help_rc=$?
+if [ "$help_rc" -ne 0 ] || [ -s "$work/help.err" ]; then
+  fail "--help: exit $help_rc, stderr: $(cat "$work/help.err")"
+else
+  missing=""
+  for option in --bag --config --classes --async --out --stats-out --help; do
+    grep -q -- "$option" "$work/help.txt" || missing="$missing $option"
+  done
+  described=$(grep -o -e "(default: " -e "(required)" "$work/help.txt" | wc -l)
+  if [ -n "$missing" ]; then
+    fail "--help does not name:$missing"
+  elif [ "$described" -lt 6 ]; then
+    fail "--help gives a default (or 'required') for $described of the 6 options"
+  else
+    pass "--help names every option with its default, exit 0"
+  fi
+fi
+expect_input_error "abbreviated option" "unknown argument '--conf'" --bag "$work/drive.bag" --out "$work/x" --conf c.yaml
+
+# 8. --stats-out: one CSV row per frame read (used or skipped), CPU time and RSS; startup_s
+# in the summary and the first-frame line on stderr.
+if run_mapper --bag "$work/loop.bag" --config "$exact_config" --out "$work/stats" \
+    --stats-out "$work/stats.csv" >/dev/null 2>"$work/stats.err"; then
+  /usr/bin/python3 - "$work/stats.csv" "$work/stats/summary.txt" "$work/stats.err" <<'EOF' \
+    && pass "--stats-out: 50 rows (25 used, 25 skipped), startup_s" || fail "--stats-out checks"
+import csv, json, re, sys
+rows = list(csv.reader(open(sys.argv[1])))
+assert rows[0] == ["frame", "stamp", "cpu_s", "rss_kb"], rows[0]
+rows = rows[1:]
+assert len(rows) == 50, f"{len(rows)} rows, expected 50 (every frame read)"
+assert [int(r[0]) for r in rows] == list(range(50)), "frame is the 0-based count"
+stamps = [float(r[1]) for r in rows]
+# The loop bag: 25 masks at T0 + 0.1 k, then the same stamps again.
+expected = [1700000000.0 + 0.1 * (k % 25 + 1) for k in range(50)]
+assert all(abs(a - b) < 1e-5 for a, b in zip(stamps, expected)), stamps[:3]
+cpu = [float(r[2]) for r in rows]
+assert cpu[0] > 0 and all(b >= a for a, b in zip(cpu, cpu[1:])), "cpu_s not non-decreasing"
+assert all(int(r[3]) > 10000 for r in rows), "rss_kb"
+summary = open(sys.argv[2]).read()
+m = re.search(r"^startup_s: ([0-9.]+) ", summary, re.M)
+assert m and 0 < float(m.group(1)) < 60, "startup_s in the summary"
+meta = json.load(open(sys.argv[2].replace("summary.txt", "map.json")))["metadata"]
+assert abs(meta["startup_s"] - float(m.group(1))) < 1e-3, "map.json metadata startup_s"
+err = open(sys.argv[3]).read()
+assert re.search(r"^map_from_bag: first frame mapped after [0-9]+\.[0-9]{3} s$", err, re.M), err
+print(f"ok: {len(rows)} rows; cpu {cpu[0]:.3f} -> {cpu[-1]:.3f} s; startup_s {m.group(1)}")
+EOF
+else
+  fail "map_from_bag --stats-out exited $?: $(tail -3 "$work/stats.err")"
+fi
+rc=0
+run_mapper --bag "$work/drive.bag" --out "$work/x" --stats-out "$work/no_dir/stats.csv" \
+  >/dev/null 2>"$work/stderr" || rc=$?
+if [ "$rc" -eq 1 ] && [ "$(wc -l <"$work/stderr")" -eq 1 ] && grep -q "stats" "$work/stderr"; then
+  pass "unwritable --stats-out -> exit 1: $(cat "$work/stderr")"
+else
+  fail "unwritable --stats-out: exit $rc: $(cat "$work/stderr")"
+fi
 
 if [ "$failures" -ne 0 ]; then
   echo "$failures check(s) failed"

@@ -20,7 +20,7 @@ namespace ipm_road_mapper {
 // IPM and its error model.
 struct IpmOptions {
   double max_range_m = 40.0;  // ground points farther than this are rejected
-  IpmErrorModel error_model;  // Omega_p inputs (DESIGN.md defaults)
+  IpmErrorModel error_model;  // Omega_p inputs (docs/design.md defaults)
 };
 
 // How lane lines become splines (config section `lanes`).

@@ -1,0 +1,35 @@
+// Streams a bag's mapper input through a MappingSession in one pass, as map_from_bag runs
+// it: masks, odometry and camera_info read and deserialized ahead in the BagPrefetcher's
+// thread, each mask paired with its camera_info (CameraInfoPairing) and handed to the
+// session in bag order, so mapping starts with the first messages. Only the first
+// camera_infos are read beforehand (the "approximate" window). Offline only.
+#pragma once
+
+#include <rosbag/bag.h>
+
+#include <cstddef>
+#include <functional>
+#include <optional>
+
+#include "ipm_road_mapper/core/mapper/input_options.h"
+#include "ipm_road_mapper/pipeline/mapping_session.h"
+
+namespace ipm_road_mapper {
+
+// What the caller hears while the bag is mapped (each callback may be empty).
+struct BagMappingCallbacks {
+  // After every frame (a mask message) was handed to the session, used or skipped:
+  // `frame` is its 0-based index, `stamp` its header stamp (s; NaN when the message did not
+  // deserialize).
+  std::function<void(std::size_t frame, double stamp)> frame_done;
+  // Once, when the Mapper used its first frame.
+  std::function<void()> first_frame_mapped;
+};
+
+// Maps the `input` topics of the open bag into the started session, then finishes it
+// (waiting frames decided, the last window solved). Returns the number of frames read.
+// Throws rosbag::BagException on a corrupt bag (after the messages before it).
+std::size_t MapBag(const rosbag::Bag& bag, const InputOptions& input, MappingSession* session,
+                   const BagMappingCallbacks& callbacks);
+
+}  // namespace ipm_road_mapper
