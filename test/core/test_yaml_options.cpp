@@ -379,6 +379,8 @@ TEST(OptionLoaders, SizesAndProbabilitiesOutOfRangeNameTheKey) {
             "association.lane_min_support: must be in [0, 1] (got 1.5)");
   EXPECT_EQ(error("association: {marking_merge_overlap: -0.1}"),
             "association.marking_merge_overlap: must be in [0, 1] (got -0.1)");
+  EXPECT_EQ(error("extraction: {min_lane_points: 1}"),
+            "extraction.min_lane_points: must be >= 2 (got 1)");
   EXPECT_EQ(error("odometry: {buffer_size: 0}"), "odometry.buffer_size: must be > 0 (got 0)");
   EXPECT_EQ(error("backend: {window_frames: 0}"), "backend.window_frames: must be > 0 (got 0)");
   EXPECT_EQ(error("backend: {queue_size: 0}"), "backend.queue_size: must be > 0 (got 0)");
