@@ -34,16 +34,34 @@ double CornerError(const std::array<Eigen::Vector3d, 4>& map_corners,
   return best;
 }
 
+// Most candidate pairs GatedCandidates collects: only markings piled on each other (a
+// hostile map) come near it, and they would otherwise cost N * M memory.
+constexpr std::size_t kMaxMarkingCandidates = 10'000'000;
+
 // All same-class pairs within the gate, nearest first (ties broken by index: deterministic).
+// GT markings are searched in a window of +-gate_m in x (sorted by center x), so spread-out
+// maps cost O(N log M); a MapFormatError when the pairs exceed kMaxMarkingCandidates.
 std::vector<Candidate> GatedCandidates(const VectorMap& map, const GroundTruth& gt, double gate_m) {
+  std::vector<std::pair<double, int>> gt_by_x;  // (center x, GT index)
+  gt_by_x.reserve(gt.markings.size());
+  for (std::size_t j = 0; j < gt.markings.size(); ++j) {
+    gt_by_x.emplace_back(gt.markings[j].center_map.x(), static_cast<int>(j));
+  }
+  std::sort(gt_by_x.begin(), gt_by_x.end());
   std::vector<Candidate> candidates;
   for (std::size_t i = 0; i < map.markings.size(); ++i) {
     const Eigen::Vector3d center = map.markings[i].Center();
-    for (std::size_t j = 0; j < gt.markings.size(); ++j) {
+    auto it =
+        std::lower_bound(gt_by_x.begin(), gt_by_x.end(), std::make_pair(center.x() - gate_m, -1));
+    for (; it != gt_by_x.end() && it->first <= center.x() + gate_m; ++it) {
+      const int j = it->second;
       if (gt.markings[j].class_id != map.markings[i].class_id) continue;
       const double distance = (center - gt.markings[j].center_map).norm();
-      if (distance <= gate_m) {
-        candidates.push_back({distance, static_cast<int>(i), static_cast<int>(j)});
+      if (distance > gate_m) continue;
+      candidates.push_back({distance, static_cast<int>(i), j});
+      if (candidates.size() > kMaxMarkingCandidates) {
+        throw MapFormatError("map markings: more than " + std::to_string(kMaxMarkingCandidates) +
+                             " same-class map/GT pairs within the gate (markings piled up)");
       }
     }
   }

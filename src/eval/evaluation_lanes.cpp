@@ -2,6 +2,7 @@
 // of the MonoLaneMapping convention (docs/file_formats.md, "Metrics JSON").
 #include <algorithm>
 #include <cmath>
+#include <cstdio>
 #include <map>
 #include <memory>
 #include <stdexcept>
@@ -37,6 +38,27 @@ double F1Score(double precision, double recall) {
   if (std::isnan(recall)) return kNoValue;
   const double p = std::isnan(precision) ? 0.0 : precision;
   return p + recall > 0.0 ? 2.0 * p * recall / (p + recall) : 0.0;
+}
+
+// Refuses a map whose lanes, sampled at options.lane_sample_spacing_m, exceed
+// options.max_lane_samples (a hostile map with a control point 1e6 m away would otherwise
+// cost 10^7 samples and as many nearest-point queries per lane).
+void CheckLaneSampleBudget(const VectorMap& map, const EvaluationOptions& options) {
+  double length_m = 0.0;
+  for (std::size_t i = 0; i < map.lanes.size(); ++i) {
+    const std::vector<Eigen::Vector3d>& points = map.lanes[i].control_points_map;
+    if (points.size() < 4) continue;  // the spline constructor reports it below
+    length_m += CatmullRomSpline(points).Length();
+    const double samples = length_m / options.lane_sample_spacing_m;
+    if (!(samples <= options.max_lane_samples)) {
+      char message[200];
+      std::snprintf(message, sizeof(message),
+                    "map lanes[%zu]: the lanes up to here are %.3g m long, %.3g samples at %g m, "
+                    "beyond the evaluator's budget of %.3g samples",
+                    i, length_m, samples, options.lane_sample_spacing_m, options.max_lane_samples);
+      throw MapFormatError(message);
+    }
+  }
 }
 
 }  // namespace
@@ -120,6 +142,7 @@ LaneMetrics EvaluateLanes(const VectorMap& map, const GroundTruth& gt,
   std::vector<double> errors, errors_xy, errors_z;
   std::vector<std::vector<Eigen::Vector3d>> map_samples;
   std::vector<std::map<std::uint64_t, int>> on_samples_per_gt(gt.lanes.size());
+  CheckLaneSampleBudget(map, options);
   for (const MapLane& lane : map.lanes) {
     std::unique_ptr<CatmullRomSpline> spline;
     try {

@@ -6,6 +6,7 @@
 
 #include <cmath>
 #include <cstdio>
+#include <filesystem>
 #include <functional>
 #include <string>
 #include <vector>
@@ -254,6 +255,152 @@ TEST(MapperOptions, ShippedMapperYamlLoads) {
   const std::string dump = ToString(o);
   EXPECT_NE(dump.find("ipm.max_range_m"), std::string::npos);
   EXPECT_NE(dump.find("ipm.pitch_sigma_deg"), std::string::npos);
+}
+
+// ---------------------------------------------------------------------------------------
+// Hostile config: types, file names and bounds that cannot work
+// ---------------------------------------------------------------------------------------
+
+// Writes `yaml` to a fresh temporary file and returns its path.
+std::string TempYaml(const std::string& name, const std::string& yaml) {
+  const std::string path = ::testing::TempDir() + "/irm_" + name + ".yaml";
+  std::FILE* f = std::fopen(path.c_str(), "w");
+  if (f == nullptr) {
+    ADD_FAILURE() << "cannot write " << path;
+    return path;
+  }
+  std::fputs(yaml.c_str(), f);
+  std::fclose(f);
+  return path;
+}
+
+// The error of LoadMapperOptionsFile on a file holding `yaml`, without the "<path>: " prefix
+// (which it checks is there).
+std::string FileError(const std::string& name, const std::string& yaml) {
+  const std::string path = TempYaml(name, yaml);
+  const std::string error = ErrorOf([&] { LoadMapperOptionsFile(path); });
+  std::remove(path.c_str());
+  EXPECT_TRUE(StartsWith(error, path + ": ")) << error;
+  EXPECT_EQ(error.find('\n'), std::string::npos) << error;
+  return StartsWith(error, path + ": ") ? error.substr(path.size() + 2) : error;
+}
+
+TEST(OptionsReader, WrongTypeSaysWhatWasExpectedAndWhatWasFound) {
+  OptionsReader root = ReaderOf(
+      "s: {number: abc, count: 2.5, list: 3, text: [1, 2], flag: {a: 1}, empty: , big: "
+      "99999999999}");
+  OptionsReader s = root.Child("s");
+  double number = 1.0;
+  int count = 1, big = 0;
+  std::vector<double> list;
+  std::string text;
+  bool flag = false;
+  EXPECT_EQ(ErrorOf([&] { s.Read("number", &number); }),
+            "s.number: wrong type: expected a number, got the scalar 'abc'");
+  EXPECT_EQ(ErrorOf([&] { s.Read("count", &count); }),
+            "s.count: wrong type: expected an integer, got the scalar '2.5'");
+  EXPECT_EQ(ErrorOf([&] { s.Read("big", &big); }),
+            "s.big: wrong type: expected an integer, got the scalar '99999999999'");
+  EXPECT_EQ(ErrorOf([&] { s.Read("list", &list); }),
+            "s.list: wrong type: expected a sequence of numbers, got the scalar '3'");
+  EXPECT_EQ(ErrorOf([&] { s.Read("text", &text); }),
+            "s.text: wrong type: expected a string, got a sequence");
+  EXPECT_EQ(ErrorOf([&] { s.Read("flag", &flag); }),
+            "s.flag: wrong type: expected true or false, got a map");
+  EXPECT_EQ(ErrorOf([&] { s.Read("empty", &number); }),
+            "s.empty: wrong type: expected a number, got null");
+  EXPECT_EQ(number, 1.0);
+}
+
+TEST(OptionsReader, NonScalarKeysAreOptionsErrors) {
+  OptionsReader root = ReaderOf("? [a, b]\n: 1\n");
+  EXPECT_EQ(ErrorOf([&] { root.RejectUnknownKeys(); }),
+            "<root>: a key is a sequence, expected a name");
+  EXPECT_EQ(FileError("base_map", "base: {x: 1}\n"),
+            "base: wrong type: expected a string, got a map");
+}
+
+TEST(MapperOptions, FileErrorsNameTheFileAndTheKey) {
+  EXPECT_EQ(FileError("type_number", "ipm: {max_range_m: far}\n"),
+            "ipm.max_range_m: wrong type: expected a number, got the scalar 'far'");
+  EXPECT_EQ(FileError("type_map", "ipm: [1, 2]\n"), "ipm: must be a map");
+  EXPECT_EQ(FileError("type_list", "backend: {translation_prior_sigma_m: {x: 1}}\n"),
+            "backend.translation_prior_sigma_m: wrong type: expected a sequence of numbers, "
+            "got a map");
+  EXPECT_EQ(FileError("type_string", "input: {sync: [exact]}\n"),
+            "input.sync: wrong type: expected a string, got a sequence");
+  EXPECT_EQ(FileError("chord", "lanes: {chord_spacing_m: 1e-4}\n"),
+            "lanes.chord_spacing_m: must be >= 0.5 m (got 0.0001)");
+}
+
+TEST(IpmOptions, AllErrorSourcesZeroOrNegativePixelErrorsAreRejected) {
+  auto load = [](const std::string& yaml) { return [yaml] { LoadMapperOptions(ReaderOf(yaml)); }; };
+  EXPECT_EQ(
+      ErrorOf(load("ipm: {pixel_error_px: [0, 0], pitch_sigma_deg: 0, height_sigma_m: 0}")),
+      "ipm: pixel_error_px, pitch_sigma_deg and height_sigma_m are all 0: at least one must be "
+      "> 0");
+  EXPECT_EQ(ErrorOf(load("ipm: {pixel_error_px: [-1, 2]}")), "ipm.pixel_error_px: must be >= 0");
+  EXPECT_EQ(ErrorOf(load("ipm: {pixel_error_px: [2, -0.5]}")), "ipm.pixel_error_px: must be >= 0");
+  // One source is enough.
+  for (const char* one : {"ipm: {pixel_error_px: [0, 0], pitch_sigma_deg: 0.1, height_sigma_m: 0}",
+                          "ipm: {pixel_error_px: [0, 0], pitch_sigma_deg: 0, height_sigma_m: 0.1}",
+                          "ipm: {pixel_error_px: [0, 1], pitch_sigma_deg: 0, height_sigma_m: 0}"}) {
+    EXPECT_NO_THROW(LoadMapperOptions(ReaderOf(one))) << one;
+  }
+}
+
+TEST(LaneOptions, ChordSpacingHasAFloor) {
+  EXPECT_EQ(ErrorOf([] { LoadMapperOptions(ReaderOf("lanes: {chord_spacing_m: 0.49}")); }),
+            "lanes.chord_spacing_m: must be >= 0.5 m (got 0.49)");
+  EXPECT_EQ(ErrorOf([] { LoadMapperOptions(ReaderOf("lanes: {chord_spacing_m: .inf}")); }),
+            "lanes.chord_spacing_m: must be >= 0.5 m (got inf)");
+  const MapperOptions o = LoadMapperOptions(ReaderOf("lanes: {chord_spacing_m: 0.5}"));
+  EXPECT_EQ(o.lanes.fit.chord_spacing_m, 0.5);
+}
+
+TEST(BackendOptions, SolvingLessOftenThanTheWindowIsRejected) {
+  EXPECT_EQ(ErrorOf([] {
+              LoadMapperOptions(ReaderOf("backend: {window_frames: 10, solve_every_n_frames: 20}"));
+            }),
+            "backend.solve_every_n_frames: must be <= window_frames (10), got 20");
+  EXPECT_NO_THROW(
+      LoadMapperOptions(ReaderOf("backend: {window_frames: 10, solve_every_n_frames: 10}")));
+}
+
+TEST(OptionLoaders, SizesAndProbabilitiesOutOfRangeNameTheKey) {
+  auto error = [](const std::string& yaml) {
+    return ErrorOf([yaml] { LoadMapperOptions(ReaderOf(yaml)); });
+  };
+  EXPECT_EQ(error("extraction: {lane_row_step: 0}"),
+            "extraction.lane_row_step: must be > 0 (got 0)");
+  EXPECT_EQ(error("extraction: {max_instances_per_frame: -1}"),
+            "extraction.max_instances_per_frame: must be > 0 (got -1)");
+  EXPECT_EQ(error("association: {lane_min_support: 1.5}"),
+            "association.lane_min_support: must be in [0, 1] (got 1.5)");
+  EXPECT_EQ(error("association: {marking_merge_overlap: -0.1}"),
+            "association.marking_merge_overlap: must be in [0, 1] (got -0.1)");
+  EXPECT_EQ(error("extraction: {min_lane_points: 1}"),
+            "extraction.min_lane_points: must be >= 2 (got 1)");
+  EXPECT_EQ(error("odometry: {buffer_size: 0}"), "odometry.buffer_size: must be > 0 (got 0)");
+  EXPECT_EQ(error("backend: {window_frames: 0}"), "backend.window_frames: must be > 0 (got 0)");
+  EXPECT_EQ(error("backend: {queue_size: 0}"), "backend.queue_size: must be > 0 (got 0)");
+  EXPECT_EQ(error("lanes: {selected_points_per_frame: 0}"),
+            "lanes.selected_points_per_frame: must be > 0 (got 0)");
+}
+
+TEST(MapperOptions, EveryShippedMapperConfigLoads) {
+  std::vector<std::string> paths = {kConfigDir + "/mapper.yaml"};
+  for (const auto& entry : std::filesystem::directory_iterator(kConfigDir + "/ablations")) {
+    if (entry.path().extension() == ".yaml") paths.push_back(entry.path().string());
+  }
+  EXPECT_GE(paths.size(), 8u);  // mapper.yaml and the 7 ablations of the benchmark
+  for (const std::string& path : paths) {
+    try {
+      LoadMapperOptionsFile(path);
+    } catch (const OptionsError& e) {
+      ADD_FAILURE() << e.what();
+    }
+  }
 }
 
 // ---------------------------------------------------------------------------------------

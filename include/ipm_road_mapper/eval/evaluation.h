@@ -28,6 +28,9 @@ struct EvaluationOptions {
   double ipm_grid_min_ahead_m = 5.0;     // grid pixels whose true ground point is this far
   double ipm_grid_max_ahead_m = 30.0;    //   ahead (base_link x) are used
   std::int64_t map_bytes = -1;           // size of the map file; < 0: size of the serialized map
+  // Most mapped-spline samples over all lanes (100 km at 0.1 m, about 1.5 s of sampling and
+  // queries); a map needing more is refused with a MapFormatError before any sampling.
+  double max_lane_samples = 1e6;
 };
 
 // Value of a metric that cannot be computed (no data); written as null in the JSON.

@@ -75,6 +75,11 @@ BackendOptions LoadBackendOptions(OptionsReader reader) {
                                              : LaneResidual::kNone;
   reader.Read<int>("window_frames", &o.window_frames, CheckPositiveInt);
   reader.Read<int>("solve_every_n_frames", &o.solve_every_n_frames, CheckPositiveInt);
+  if (o.solve_every_n_frames > o.window_frames) {  // frames between two windows: never solved
+    throw OptionsError(reader.KeyPath("solve_every_n_frames") + ": must be <= window_frames (" +
+                       std::to_string(o.window_frames) + "), got " +
+                       std::to_string(o.solve_every_n_frames));
+  }
   reader.Read<int>("rounds", &o.rounds, CheckPositiveInt);
   reader.Read<int>("max_iterations", &o.max_iterations, CheckPositiveInt);
   reader.Read<int>("queue_size", &o.queue_size, CheckPositiveInt);

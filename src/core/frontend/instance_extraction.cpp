@@ -135,7 +135,10 @@ ExtractionOptions LoadExtractionOptions(OptionsReader reader) {
   reader.Read<int>("min_lane_pixels", &o.min_lane_pixels, CheckPositiveInt);
   reader.Read<int>("border_margin_px", &o.border_margin_px, CheckNonNegativeInt);
   reader.Read<int>("lane_row_step", &o.lane_row_step, CheckPositiveInt);
-  reader.Read<int>("min_lane_points", &o.min_lane_points, CheckPositiveInt);
+  reader.Read<int>("min_lane_points", &o.min_lane_points, [](const int& v) -> std::string {
+    // One point has no direction: the lane association and fit need two.
+    return v >= 2 ? "" : "must be >= 2 (got " + std::to_string(v) + ")";
+  });
   reader.Read<int>("max_instances_per_frame", &o.max_instances_per_frame, CheckPositiveInt);
   reader.Read<double>("max_marking_range_m", &o.max_marking_range_m, CheckPositive);
   reader.Read<double>("min_rectangle_side_m", &o.min_rectangle_side_m, CheckNonNegative);

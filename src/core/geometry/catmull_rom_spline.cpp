@@ -145,12 +145,22 @@ std::vector<Eigen::Vector3d> CatmullRomSpline::SampleByArcLength(double spacing_
     throw std::invalid_argument("CatmullRomSpline::SampleByArcLength: spacing must be > 0");
   }
   const double length = Length();
-  std::vector<Eigen::Vector3d> samples;
+  if (!std::isfinite(length)) {
+    throw std::invalid_argument("CatmullRomSpline::SampleByArcLength: the length is not finite");
+  }
   // Regular samples strictly before the end (a sample within 1e-9 m of it would duplicate it).
-  const int count = static_cast<int>(std::ceil(length / spacing_m - 1e-9));
-  samples.reserve(count + 1);
+  // The count is computed in double and bounded before any conversion to int.
+  double spacing = spacing_m;
+  double wanted = std::ceil(length / spacing - 1e-9);
+  if (wanted > kMaxArcLengthSamples) {
+    spacing = length / kMaxArcLengthSamples;
+    wanted = kMaxArcLengthSamples;
+  }
+  const int count = std::max(0, static_cast<int>(wanted));
+  std::vector<Eigen::Vector3d> samples;
+  samples.reserve(static_cast<std::size_t>(count) + 1);
   for (int k = 0; k < count; ++k) {
-    samples.push_back(Evaluate(ParameterAtArcLength(k * spacing_m)));
+    samples.push_back(Evaluate(ParameterAtArcLength(k * spacing)));
   }
   samples.push_back(Evaluate(NumSegments()));
   return samples;

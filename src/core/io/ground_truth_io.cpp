@@ -6,6 +6,7 @@
 #include <stdexcept>
 
 #include "ipm_road_mapper/core/io/ground_truth.h"
+#include "ipm_road_mapper/core/io/json_limits.h"
 #include "ipm_road_mapper/core/map/vector_map.h"
 #include "json_io.h"
 
@@ -22,6 +23,7 @@ constexpr int kLengthDecimals = 6;  // 1e-6 m
 constexpr int kQuaternionDecimals = 9;
 constexpr int kStampDecimals = 9;  // 1 ns, the resolution of ros::Time
 constexpr int kIndent = 1;
+constexpr int kMaxImageSidePx = 16384;  // the largest camera image side a file may state
 
 nlohmann::json RoundedPose(const Eigen::Isometry3d& T) {
   nlohmann::json j = PoseToJson(T);
@@ -45,6 +47,13 @@ CameraIntrinsics CameraFromJson(const nlohmann::json& j, const std::string& wher
   CameraIntrinsics c;
   c.width = json_io::ReadInt(Member(j, "width", where), Key(where, "width"));
   c.height = json_io::ReadInt(Member(j, "height", where), Key(where, "height"));
+  // The evaluator walks a pixel grid over the image: an absurd size would never finish.
+  for (const auto& [key, size] : {std::pair{"width", c.width}, std::pair{"height", c.height}}) {
+    if (size < 1 || size > kMaxImageSidePx) {
+      Fail(Key(where, key),
+           std::to_string(size) + " px is outside [1, " + std::to_string(kMaxImageSidePx) + "]");
+    }
+  }
   c.fx = json_io::ReadNumber(Member(j, "fx", where), Key(where, "fx"));
   c.fy = json_io::ReadNumber(Member(j, "fy", where), Key(where, "fy"));
   c.cx = json_io::ReadNumber(Member(j, "cx", where), Key(where, "cx"));
@@ -114,7 +123,8 @@ GroundTruthLane LaneFromJson(const nlohmann::json& j, const std::string& where) 
   lane.class_name = json_io::OptionalString(j, "class_name", "", where);
   lane.style = json_io::OptionalString(j, "style", "", where);
   const std::string points_where = Key(where, "points");
-  const nlohmann::json& points = json_io::ReadArray(Member(j, "points", where), points_where);
+  const nlohmann::json& points = json_io::ReadArray(Member(j, "points", where), points_where,
+                                                    json_limits::kMaxGroundTruthLanePoints);
   if (points.size() < 2) Fail(points_where, "a lane needs at least 2 points");
   lane.points_map.reserve(points.size());
   for (std::size_t k = 0; k < points.size(); ++k) {
@@ -139,8 +149,9 @@ GroundTruthFrame FrameFromJson(const nlohmann::json& j, const std::string& where
 
 // Reads the array `key` of the root, converting each element with `from_json`.
 template <typename T, typename FromJson>
-std::vector<T> ReadList(const nlohmann::json& root, const char* key, FromJson from_json) {
-  const nlohmann::json& array = json_io::ReadArray(Member(root, key, ""), key);
+std::vector<T> ReadList(const nlohmann::json& root, const char* key, std::size_t max_size,
+                        FromJson from_json) {
+  const nlohmann::json& array = json_io::ReadArray(Member(root, key, ""), key, max_size);
   std::vector<T> items;
   items.reserve(array.size());
   for (std::size_t i = 0; i < array.size(); ++i) {
@@ -160,9 +171,19 @@ GroundTruth GroundTruthFromJson(const nlohmann::json& j) {
   gt.camera = CameraFromJson(Member(j, "camera", ""), "camera");
   gt.T_base_cam_true = ReadPose(j, "T_base_cam_true", "");
   gt.T_base_cam_rough = ReadPose(j, "T_base_cam_rough", "");
-  gt.markings = ReadList<GroundTruthMarking>(j, "markings", MarkingFromJson);
-  gt.lanes = ReadList<GroundTruthLane>(j, "lanes", LaneFromJson);
-  gt.frames = ReadList<GroundTruthFrame>(j, "frames", FrameFromJson);
+  gt.markings =
+      ReadList<GroundTruthMarking>(j, "markings", json_limits::kMaxMarkings, MarkingFromJson);
+  gt.lanes = ReadList<GroundTruthLane>(j, "lanes", json_limits::kMaxLanes, LaneFromJson);
+  std::size_t lane_points = 0;
+  for (std::size_t i = 0; i < gt.lanes.size(); ++i) {
+    lane_points += gt.lanes[i].points_map.size();
+    if (lane_points > json_limits::kMaxGroundTruthLanePoints) {
+      Fail(Index("lanes", i), "more than " +
+                                  std::to_string(json_limits::kMaxGroundTruthLanePoints) +
+                                  " lane points in the file");
+    }
+  }
+  gt.frames = ReadList<GroundTruthFrame>(j, "frames", json_limits::kMaxPoses, FrameFromJson);
   return gt;
 }
 

@@ -6,12 +6,13 @@
 
 #include <cerrno>
 #include <cmath>
+#include <cstdio>
 #include <cstring>
 #include <fstream>
 #include <limits>
-#include <sstream>
 #include <vector>
 
+#include "ipm_road_mapper/core/io/json_limits.h"
 #include "ipm_road_mapper/core/map/vector_map.h"
 
 namespace ipm_road_mapper {
@@ -28,6 +29,13 @@ std::string Describe(const nlohmann::json& j) {
 }
 
 std::string ErrnoText() { return std::strerror(errno); }
+
+// A number as %g prints it ("1e+08"), for messages.
+std::string ShortNumber(double value) {
+  char text[32];
+  std::snprintf(text, sizeof(text), "%g", value);
+  return text;
+}
 
 }  // namespace
 
@@ -84,15 +92,26 @@ std::string ReadString(const nlohmann::json& j, const std::string& where) {
   return j.get<std::string>();
 }
 
-const nlohmann::json& ReadArray(const nlohmann::json& j, const std::string& where) {
+const nlohmann::json& ReadArray(const nlohmann::json& j, const std::string& where,
+                                std::size_t max_size) {
   if (!j.is_array()) Fail(where, "expected an array, got " + Describe(j));
+  if (j.size() > max_size) {
+    Fail(where, std::to_string(j.size()) + " elements, more than the " + std::to_string(max_size) +
+                    " allowed");
+  }
   return j;
 }
 
 Eigen::Vector3d ReadVector3(const nlohmann::json& j, const std::string& where) {
   if (!j.is_array() || j.size() != 3) Fail(where, "expected [x, y, z]");
-  return {ReadNumber(j[0], Index(where, 0)), ReadNumber(j[1], Index(where, 1)),
-          ReadNumber(j[2], Index(where, 2))};
+  const Eigen::Vector3d v(ReadNumber(j[0], Index(where, 0)), ReadNumber(j[1], Index(where, 1)),
+                          ReadNumber(j[2], Index(where, 2)));
+  const double distance_m = v.stableNorm();  // no overflow for 1e300
+  static_assert(json_limits::kMaxCoordinateM == 1e7, "update the message below");
+  if (!(distance_m <= json_limits::kMaxCoordinateM)) {
+    Fail(where, "coordinate " + ShortNumber(distance_m) + " m beyond the 1e7 m bound");
+  }
+  return v;
 }
 
 Eigen::Isometry3d ReadPose(const nlohmann::json& j, const std::string& where) {
@@ -128,6 +147,19 @@ std::string OptionalString(const nlohmann::json& j, const char* key, const std::
   return j.contains(key) ? ReadString(j[key], Key(where, key)) : fallback;
 }
 
+void CheckDepth(const nlohmann::json& j, int max_depth, const std::string& where) {
+  std::vector<std::pair<const nlohmann::json*, int>> pending{{&j, 1}};
+  while (!pending.empty()) {
+    const auto [node, depth] = pending.back();
+    pending.pop_back();
+    if (!node->is_structured()) continue;
+    if (depth > max_depth) {
+      Fail(where, "nesting deeper than " + std::to_string(max_depth) + " levels");
+    }
+    for (const nlohmann::json& child : *node) pending.emplace_back(&child, depth + 1);
+  }
+}
+
 void CheckFormatHeader(const nlohmann::json& root, const char* format, int version) {
   if (!root.is_object()) Fail("", "the document is not a JSON object");
   const std::string found_format = ReadString(Member(root, "format", ""), "format");
@@ -155,15 +187,26 @@ nlohmann::json Vector3ToJson(const Eigen::Vector3d& v, int decimals) {
 }
 
 nlohmann::json ParseJsonFile(const std::string& path) {
-  std::ifstream in(path, std::ios::binary);
+  std::ifstream in(path, std::ios::binary | std::ios::ate);
   if (!in) throw MapFormatError(path + ": cannot open file: " + ErrnoText());
-  std::ostringstream buffer;
-  buffer << in.rdbuf();
-  if (in.bad()) throw MapFormatError(path + ": read error");
+  const std::streamoff size = in.tellg();
+  if (size < 0) throw MapFormatError(path + ": cannot read file: " + ErrnoText());
+  if (static_cast<std::uintmax_t>(size) > json_limits::kMaxFileBytes) {
+    throw MapFormatError(path + ": " + std::to_string(size) + " bytes, more than the " +
+                         std::to_string(json_limits::kMaxFileBytes) + " allowed");
+  }
+  in.seekg(0);
+  std::string text(static_cast<std::size_t>(size), '\0');
+  if (!in.read(text.data(), size)) throw MapFormatError(path + ": read error");
+  // Depth and sizes first, on the raw text: nlohmann builds (and copies) documents
+  // recursively, so a deeply nested file must never reach it.
+  const std::string problem = json_limits::ScanJsonText(text);
+  if (!problem.empty()) throw MapFormatError(path + ": " + problem);
   try {
-    return nlohmann::json::parse(buffer.str());
-  } catch (const nlohmann::json::parse_error& e) {
+    return nlohmann::json::parse(text);
+  } catch (const nlohmann::json::exception& e) {
     // e.what() is "[json.exception.parse_error.101] parse error at line 3, ...": one line.
+    // Numbers beyond the double range (1e999) come as out_of_range.406.
     std::string message = e.what();
     const std::size_t tag_end = message.find("] ");
     if (tag_end != std::string::npos) message = message.substr(tag_end + 2);

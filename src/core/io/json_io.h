@@ -8,6 +8,8 @@
 #include <nlohmann/json.hpp>
 #include <string>
 
+#include "ipm_road_mapper/core/io/json_limits.h"
+
 namespace ipm_road_mapper {
 namespace json_io {
 
@@ -29,7 +31,10 @@ double ReadNumber(const nlohmann::json& j, const std::string& where);
 int ReadInt(const nlohmann::json& j, const std::string& where);
 std::uint64_t ReadUint64(const nlohmann::json& j, const std::string& where);
 std::string ReadString(const nlohmann::json& j, const std::string& where);
-const nlohmann::json& ReadArray(const nlohmann::json& j, const std::string& where);
+// An array of at most `max_size` elements.
+const nlohmann::json& ReadArray(const nlohmann::json& j, const std::string& where,
+                                std::size_t max_size = json_limits::kMaxContainerElements);
+// [x, y, z] at most json_limits::kMaxCoordinateM from the origin.
 Eigen::Vector3d ReadVector3(const nlohmann::json& j, const std::string& where);
 // A pose {"t": [x, y, z], "q_xyzw": [qx, qy, qz, qw]}; the quaternion must be unit within
 // 1e-3 and is normalized.
@@ -41,6 +46,10 @@ double OptionalNumber(const nlohmann::json& j, const char* key, double fallback,
 int OptionalInt(const nlohmann::json& j, const char* key, int fallback, const std::string& where);
 std::string OptionalString(const nlohmann::json& j, const char* key, const std::string& fallback,
                            const std::string& where);
+
+// Fails when `j` nests arrays/objects deeper than `max_depth` levels (counting `j` itself);
+// iterative, for documents built in memory rather than parsed by ParseJsonFile.
+void CheckDepth(const nlohmann::json& j, int max_depth, const std::string& where);
 
 // Checks {"format": format, "version": version} at the root of a document.
 void CheckFormatHeader(const nlohmann::json& root, const char* format, int version);
@@ -55,8 +64,10 @@ nlohmann::json Vector3ToJson(const Eigen::Vector3d& v, int decimals = -1);
 // prints in its short form (1.55, not 1.5499999999999998).
 double RoundToDecimals(double value, int decimals);
 
-// Reads and parses a JSON file; a missing/unreadable file or a syntax error (including a
-// truncated file) throws MapFormatError naming the file.
+// Reads and parses a JSON file; a missing/unreadable file, one beyond the text limits of
+// json_limits.h (size, depth, element counts; checked before the parse) or a syntax error
+// (including a truncated file and a number beyond the double range) throws MapFormatError
+// naming the file.
 nlohmann::json ParseJsonFile(const std::string& path);
 
 // Writes `contents` to a temporary file in the folder of `path`, flushes it to disk and

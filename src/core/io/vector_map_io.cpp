@@ -4,6 +4,7 @@
 #include <sstream>
 #include <stdexcept>
 
+#include "ipm_road_mapper/core/io/json_limits.h"
 #include "ipm_road_mapper/core/map/vector_map.h"
 #include "json_io.h"
 
@@ -72,8 +73,8 @@ MapLane LaneFromJson(const nlohmann::json& j, const std::string& where) {
   lane.class_name = json_io::OptionalString(j, "class_name", "", where);
   lane.style = json_io::OptionalString(j, "style", "", where);
   const std::string points_where = Key(where, "control_points");
-  const nlohmann::json& points =
-      json_io::ReadArray(Member(j, "control_points", where), points_where);
+  const nlohmann::json& points = json_io::ReadArray(
+      Member(j, "control_points", where), points_where, json_limits::kMaxControlPointsPerLane);
   if (points.size() < 4) {
     Fail(points_where, "a lane needs at least 4 control points (2 of them phantom ends), got " +
                            std::to_string(points.size()));
@@ -128,7 +129,8 @@ VectorMap VectorMapFromJson(const nlohmann::json& j) {
       json_io::ReadPose(Member(j, "T_base_cam_initial", ""), "T_base_cam_initial");
 
   std::set<std::uint64_t> marking_ids;
-  const nlohmann::json& markings = json_io::ReadArray(Member(j, "markings", ""), "markings");
+  const nlohmann::json& markings =
+      json_io::ReadArray(Member(j, "markings", ""), "markings", json_limits::kMaxMarkings);
   for (std::size_t i = 0; i < markings.size(); ++i) {
     map.markings.push_back(MarkingFromJson(markings[i], Index("markings", i)));
     if (!marking_ids.insert(map.markings.back().id).second) {
@@ -136,15 +138,23 @@ VectorMap VectorMapFromJson(const nlohmann::json& j) {
     }
   }
   std::set<std::uint64_t> lane_ids;
-  const nlohmann::json& lanes = json_io::ReadArray(Member(j, "lanes", ""), "lanes");
+  const nlohmann::json& lanes =
+      json_io::ReadArray(Member(j, "lanes", ""), "lanes", json_limits::kMaxLanes);
+  std::size_t control_points = 0;
   for (std::size_t i = 0; i < lanes.size(); ++i) {
     map.lanes.push_back(LaneFromJson(lanes[i], Index("lanes", i)));
+    control_points += map.lanes.back().control_points_map.size();
+    if (control_points > json_limits::kMaxControlPoints) {
+      Fail(Index("lanes", i), "more than " + std::to_string(json_limits::kMaxControlPoints) +
+                                  " control points in the map");
+    }
     if (!lane_ids.insert(map.lanes.back().id).second) {
       Fail(Index("lanes", i), "duplicate id " + std::to_string(map.lanes.back().id));
     }
   }
   if (j.contains("trajectory")) {
-    const nlohmann::json& trajectory = json_io::ReadArray(j["trajectory"], "trajectory");
+    const nlohmann::json& trajectory =
+        json_io::ReadArray(j["trajectory"], "trajectory", json_limits::kMaxPoses);
     for (std::size_t i = 0; i < trajectory.size(); ++i) {
       const std::string where = Index("trajectory", i);
       StampedPose pose;
@@ -155,6 +165,8 @@ VectorMap VectorMapFromJson(const nlohmann::json& j) {
   }
   if (j.contains("metadata")) {
     if (!j["metadata"].is_object()) Fail("metadata", "expected an object");
+    // The copy below recurses: bound the depth first (ParseJsonFile did for files).
+    json_io::CheckDepth(j["metadata"], json_limits::kMaxDepth - 1, "metadata");
     map.metadata = j["metadata"];
   }
   return map;

@@ -15,12 +15,24 @@ OptionsReader::OptionsReader(YAML::Node node, std::string path)
 
 namespace {
 
+// Scalars longer than this are cut in messages.
+constexpr std::size_t kMaxQuotedChars = 40;
+
+// The text of a map key; a non-scalar key (`? [a, b]: 1`) is an error naming `where`.
+std::string KeyText(const YAML::Node& key, const std::string& where) {
+  if (!key.IsScalar()) {
+    throw OptionsError((where.empty() ? std::string("<root>") : where) + ": a key is " +
+                       DescribeYamlNode(key) + ", expected a name");
+  }
+  return key.Scalar();
+}
+
 // Overlays `over` on `base`: maps merge key by key (recursively), anything else replaces.
 YAML::Node Merge(const YAML::Node& base, const YAML::Node& over) {
   if (!base || !base.IsMap() || !over || !over.IsMap()) return YAML::Clone(over);
   YAML::Node merged = YAML::Clone(base);
   for (const auto& entry : over) {
-    const std::string key = entry.first.as<std::string>();
+    const std::string key = KeyText(entry.first, "");
     merged[key] = Merge(base[key], entry.second);
   }
   return merged;
@@ -37,14 +49,23 @@ YAML::Node LoadWithBase(const std::string& file_path, int depth) {
     throw OptionsError(file_path + ": malformed YAML: " + e.what());
   }
   if (!root.IsMap() || !root["base"]) return root;
-  std::string base_path = root["base"].as<std::string>();
+  if (!root["base"].IsScalar()) {
+    throw OptionsError(file_path + ": base: wrong type: expected a string, got " +
+                       DescribeYamlNode(root["base"]));
+  }
+  std::string base_path = root["base"].Scalar();
   if (!base_path.empty() && base_path[0] != '/') {
     const std::size_t slash = file_path.find_last_of('/');
     if (slash != std::string::npos) base_path = file_path.substr(0, slash + 1) + base_path;
   }
   YAML::Node overrides = YAML::Clone(root);
   overrides.remove("base");
-  return Merge(LoadWithBase(base_path, depth + 1), overrides);
+  const YAML::Node base = LoadWithBase(base_path, depth + 1);
+  try {
+    return Merge(base, overrides);
+  } catch (const OptionsError& e) {
+    throw OptionsError(file_path + ": " + e.what());
+  }
 }
 
 }  // namespace
@@ -71,11 +92,20 @@ YAML::Node OptionsReader::Raw(const std::string& key) {
 void OptionsReader::RejectUnknownKeys() const {
   if (!node_ || !node_.IsMap()) return;
   for (const auto& entry : node_) {
-    const std::string key = entry.first.as<std::string>();
+    const std::string key = KeyText(entry.first, path_);
     if (std::find(used_.begin(), used_.end(), key) == used_.end()) {
       throw OptionsError(KeyPath(key) + ": unknown key");
     }
   }
+}
+
+std::string DescribeYamlNode(const YAML::Node& node) {
+  if (!node || node.IsNull()) return "null";
+  if (node.IsSequence()) return "a sequence";
+  if (node.IsMap()) return "a map";
+  const std::string& text = node.Scalar();
+  return "the scalar '" +
+         (text.size() > kMaxQuotedChars ? text.substr(0, kMaxQuotedChars) + "..." : text) + "'";
 }
 
 std::string OptionsReader::KeyPath(const std::string& key) const {

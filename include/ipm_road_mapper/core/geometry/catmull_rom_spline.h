@@ -90,8 +90,13 @@ class CatmullRomSpline {
   // Global parameter at arc length arc_m from the start (clamped to [0, Length()]).
   double ParameterAtArcLength(double arc_m) const;
 
+  // Most samples SampleByArcLength returns (plus the end point).
+  static constexpr int kMaxArcLengthSamples = 1'000'000;
+
   // Points every spacing_m of arc length from the start, then the end point (so the last gap
-  // may be shorter). Throws std::invalid_argument unless spacing_m > 0.
+  // may be shorter). A curve longer than kMaxArcLengthSamples * spacing_m is sampled at
+  // Length() / kMaxArcLengthSamples instead, so the count (and memory) stays bounded.
+  // Throws std::invalid_argument unless spacing_m > 0 and the length is finite.
   std::vector<Eigen::Vector3d> SampleByArcLength(double spacing_m) const;
 
   // Global closest curve point to `query` over all segments. Queries beyond an end get that

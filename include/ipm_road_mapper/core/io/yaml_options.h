@@ -9,6 +9,7 @@
 #include <initializer_list>
 #include <stdexcept>
 #include <string>
+#include <type_traits>
 #include <vector>
 
 namespace ipm_road_mapper {
@@ -22,6 +23,31 @@ struct NonDeduced {
 // Validates a value: empty string when valid, else the reason.
 template <typename T>
 using OptionCheck = std::function<std::string(const typename NonDeduced<T>::type&)>;
+
+// What an option of type T must be, for wrong-type messages ("a number", "true or false").
+template <typename T>
+const char* ExpectedTypeName() {
+  if constexpr (std::is_same_v<T, bool>) {
+    return "true or false";
+  } else if constexpr (std::is_integral_v<T>) {
+    return "an integer";
+  } else if constexpr (std::is_floating_point_v<T>) {
+    return "a number";
+  } else if constexpr (std::is_same_v<T, std::string>) {
+    return "a string";
+  } else if constexpr (std::is_same_v<T, std::vector<double>>) {
+    return "a sequence of numbers";
+  } else if constexpr (std::is_same_v<T, std::vector<int>>) {
+    return "a sequence of integers";
+  } else if constexpr (std::is_same_v<T, std::vector<std::string>>) {
+    return "a sequence of strings";
+  } else {
+    return "a value of another type";
+  }
+}
+
+// What a YAML node is, for messages: "the scalar 'abc'", "a sequence", "a map", "null".
+std::string DescribeYamlNode(const YAML::Node& node);
 
 // Thrown for any invalid option; what() is one line naming the key path.
 class OptionsError : public std::runtime_error {
@@ -51,8 +77,10 @@ class OptionsReader {
     if (!node_[key]) return;
     try {
       *value = node_[key].as<T>();
-    } catch (const YAML::Exception& e) {
-      throw OptionsError(KeyPath(key) + ": wrong type (" + e.msg + ")");
+    } catch (const YAML::Exception&) {
+      // yaml-cpp's own message ("bad conversion") names neither the key nor the types.
+      throw OptionsError(KeyPath(key) + ": wrong type: expected " + ExpectedTypeName<T>() +
+                         ", got " + DescribeYamlNode(node_[key]));
     }
     if (check) {
       const std::string reason = check(*value);
