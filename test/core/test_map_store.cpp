@@ -65,6 +65,61 @@ TEST(MapStore, RoadDirectionIsTheNearestLanesTangent) {
   EXPECT_EQ(store.RoadDirectionAt(Eigen::Vector3d(0.0, -30.0, 0.0)), Eigen::Vector3d::Zero());
 }
 
+MarkingElement MarkingAt(std::uint64_t id, double x, double y, std::size_t last_frame) {
+  MarkingElement m;
+  m.id = id;
+  m.class_id = 10;
+  m.corners_map = {Eigen::Vector3d(x - 1, y - 0.5, 0), Eigen::Vector3d(x + 1, y - 0.5, 0),
+                   Eigen::Vector3d(x + 1, y + 0.5, 0), Eigen::Vector3d(x - 1, y + 0.5, 0)};
+  m.center_cov_map = 0.04 * Eigen::Matrix2d::Identity();
+  m.last_frame = last_frame;
+  return m;
+}
+
+TEST(MapStore, RetiredMarkingsLeaveTheLiveSetAndAreFoundByPlace) {
+  MapStore store(4.0);
+  store.markings().push_back(MarkingAt(1, 0.0, 0.0, 10));
+  store.markings().push_back(MarkingAt(2, 25.0, 0.0, 50));
+  store.markings().push_back(MarkingAt(3, 9.5, 0.5, 12));
+  store.markings()[0].retired = store.markings()[1].retired = store.markings()[2].retired = true;
+  store.RetireMarkings(20);  // 2 was seen at frame 50: stays live
+  ASSERT_EQ(store.markings().size(), 1u);
+  EXPECT_EQ(store.markings()[0].id, 2u);
+  ASSERT_EQ(store.retired_markings().size(), 2u);
+  EXPECT_DOUBLE_EQ(store.max_retired_cov_trace(), 0.08);
+  // Across a cell border (cells of 10 m): 3 at x = 9.5 from a query at x = 10.5.
+  const std::vector<std::size_t> near = store.RetiredMarkingsNear(Eigen::Vector3d(10.5, 0, 0), 1.5);
+  ASSERT_EQ(near.size(), 1u);
+  EXPECT_EQ(store.retired_markings()[near[0]].id, 3u);
+  EXPECT_EQ(store.RetiredMarkingsNear(Eigen::Vector3d(5.0, 0, 0), 5.1).size(), 2u);
+  EXPECT_TRUE(store.RetiredMarkingsNear(Eigen::Vector3d(5.0, 0, 0), std::nan("")).empty());
+  // A huge radius scans instead of visiting cells.
+  EXPECT_EQ(store.RetiredMarkingsNear(Eigen::Vector3d(5.0, 0, 0), 1e12).size(), 2u);
+  // Revived: back among the live ones, and no longer found among the retired.
+  const std::size_t live = store.ReviveMarking(near[0]);
+  EXPECT_EQ(store.markings()[live].id, 3u);
+  EXPECT_TRUE(store.RetiredMarkingsNear(Eigen::Vector3d(10.5, 0, 0), 1.5).empty());
+  EXPECT_EQ(store.RetiredMarkingsNear(Eigen::Vector3d(0.0, 0, 0), 1.0).size(), 1u);
+}
+
+TEST(MapStore, PruningKeepsCountsAndTheRecentMeasurements) {
+  MapStore store(4.0);
+  MarkingElement m = MarkingAt(1, 0.0, 0.0, 9);
+  for (std::size_t f = 0; f < 10; ++f) m.history.push_back(MarkingMeasurement{f, {}, {}, {}});
+  store.markings().push_back(m);
+  LaneElement lane;
+  for (std::size_t f = 0; f < 10; ++f) lane.history.push_back(LaneMeasurement{f, {}, {}, {}});
+  store.lanes().push_back(lane);
+  store.PruneHistoriesBefore(6);
+  EXPECT_EQ(store.markings()[0].history.size(), 4u);
+  EXPECT_EQ(store.markings()[0].history.front().frame_index, 6u);
+  EXPECT_EQ(store.markings()[0].Observations(), 10u);
+  EXPECT_EQ(store.lanes()[0].history.size(), 4u);
+  EXPECT_EQ(store.lanes()[0].Observations(), 10u);
+  store.PruneHistoriesBefore(3);  // nothing older left
+  EXPECT_EQ(store.markings()[0].Observations(), 10u);
+}
+
 TEST(MapStore, ClearDropsEverythingButIdsStayUnique) {
   MapStore store(4.0);
   store.AddFrame(1.0, Eigen::Isometry3d::Identity());

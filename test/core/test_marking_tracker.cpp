@@ -71,6 +71,22 @@ TEST(MarkingTracker, DuplicatesOfOneClassMergeOthersDoNot) {
   EXPECT_EQ(arrow.history.size(), 2u);
 }
 
+TEST(MarkingTracker, RetiredMarkingSeenAgainIsTheSameElement) {
+  Rig rig;
+  for (int k = 0; k < 3; ++k) rig.Step(RoadFrame(100.0 + 0.05 * k, 0.5 * k));
+  ASSERT_EQ(rig.store.markings().size(), 1u);
+  const std::uint64_t id = rig.store.markings()[0].id;
+  rig.store.markings()[0].retired = true;
+  rig.store.RetireMarkings(100);  // left the window
+  ASSERT_TRUE(rig.store.markings().empty());
+  rig.Step(RoadFrame(100.15, 1.5));  // seen again after the gap
+  ASSERT_EQ(rig.store.markings().size(), 1u);
+  EXPECT_TRUE(rig.store.retired_markings().empty());
+  EXPECT_EQ(rig.store.markings()[0].id, id);
+  EXPECT_EQ(rig.store.markings()[0].history.size(), 4u);
+  EXPECT_EQ(rig.counters.markings_created, 1u);
+}
+
 TEST(MarkingTracker, MarkingSeenOnceIsDroppedAfterTheHorizon) {
   Rig rig;
   rig.Step(RoadFrame(100.0, 0.0));

@@ -4,6 +4,8 @@
 // end of input runs the final global solve. Synchronous back end: deterministic.
 #include <gtest/gtest.h>
 
+#include <chrono>
+
 #include "common/road_scene.h"
 #include "ipm_road_mapper/core/frontend/instance_extraction.h"
 #include "ipm_road_mapper/core/mapper/lane_tracker.h"
@@ -113,13 +115,39 @@ TEST(WindowCoordinator, ResultLandsOnTheRightControlPointsOfAGrownLane) {
 TEST(WindowCoordinator, MarkingsRetireAndTheFinalSolveRuns) {
   Rig rig(SynchronousOptions());
   for (int k = 0; k < 80; ++k) rig.Step(DriftingFrame(k));  // the arrow is passed at k ~ 40
-  ASSERT_EQ(rig.store.markings().size(), 1u);
-  EXPECT_TRUE(rig.store.markings()[0].retired);
+  // The arrow left the window: retired, out of the live markings.
+  EXPECT_TRUE(rig.store.markings().empty());
+  ASSERT_EQ(rig.store.retired_markings().size(), 1u);
+  EXPECT_TRUE(rig.store.retired_markings()[0].retired);
   rig.windows.ApplyResults();  // the window submitted by the last frame
   const std::uint64_t applied = rig.counters.results_applied;
   rig.windows.Finish();
   // The last window and the global solve.
   EXPECT_EQ(rig.counters.results_applied, applied + 2);
+}
+
+TEST(WindowCoordinator, FinishKeepsItsTimeBudget) {
+  MapperOptions options = SynchronousOptions();
+  options.backend.synchronous = false;  // a real optimizer thread, as on a vehicle
+  Rig rig(options);
+  for (int k = 0; k < 60; ++k) rig.Step(DriftingFrame(k));
+  const auto start = std::chrono::steady_clock::now();
+  rig.windows.Finish(0.0);  // nothing may be waited for
+  const double took_s =
+      std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
+  EXPECT_LT(took_s, 0.5);  // one snapshot, no solve waited for (a window solve takes ~50 ms)
+  Rig unbounded(SynchronousOptions());
+  for (int k = 0; k < 60; ++k) unbounded.Step(DriftingFrame(k));
+  EXPECT_TRUE(unbounded.windows.Finish());
+}
+
+TEST(WindowCoordinator, WithoutBackendMarkingsRetireToo) {
+  MapperOptions options = SynchronousOptions();
+  options.backend.enabled = false;
+  Rig rig(options);
+  for (int k = 0; k < 80; ++k) rig.Step(DriftingFrame(k));
+  EXPECT_TRUE(rig.store.markings().empty());
+  EXPECT_EQ(rig.store.retired_markings().size(), 1u);
 }
 
 TEST(WindowCoordinator, WithoutBackendNothingIsSubmitted) {

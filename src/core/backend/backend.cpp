@@ -1,5 +1,8 @@
 #include "ipm_road_mapper/core/backend/backend.h"
 
+#include <algorithm>
+#include <chrono>
+
 #include <utility>
 
 #include "ipm_road_mapper/core/mapper/timing_series.h"
@@ -55,6 +58,16 @@ std::vector<std::shared_ptr<const WindowResult>> Backend::TakeResults() {
 void Backend::WaitIdle() {
   std::unique_lock<std::mutex> lock(mutex_);
   idle_.wait(lock, [this] { return stop_ || (queue_.empty() && !busy_); });
+}
+
+bool Backend::WaitIdleFor(double timeout_s) {
+  std::unique_lock<std::mutex> lock(mutex_);
+  auto idle = [this] { return stop_ || (queue_.empty() && !busy_); };
+  if (!(timeout_s < 1e9)) {
+    idle_.wait(lock, idle);
+    return true;
+  }
+  return idle_.wait_for(lock, std::chrono::duration<double>(std::max(0.0, timeout_s)), idle);
 }
 
 BackendStats Backend::stats() const {

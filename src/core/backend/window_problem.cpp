@@ -75,6 +75,7 @@ struct WindowState {
   std::vector<CornerMeasurement> corner_measurements;
   std::vector<LanePixel> lane_pixels;
   std::vector<Eigen::Isometry3d> poses;  // the frames' poses at the start (road surface)
+  double step_time_limit_s = std::numeric_limits<double>::infinity();  // of the next step
   explicit WindowState(const WindowSnapshot& s) : extrinsic(s.T_base_cam) {
     for (std::size_t i = 0; i < s.frames.size(); ++i) {
       frames.emplace_back(s.frames[i].T_map_base);
@@ -220,10 +221,12 @@ void ConfigurePoint(const BackendOptions& options, double* point, ceres::Problem
   if (!options.optimize_z) problem->SetManifold(point, new ceres::SubsetManifold(3, {2}));
 }
 
-ceres::Solver::Summary Solve(const BackendOptions& options, ceres::Problem* problem) {
+ceres::Solver::Summary Solve(const BackendOptions& options, double time_limit_s,
+                             ceres::Problem* problem) {
   ceres::Solver::Options solver;
   solver.linear_solver_type = ceres::SPARSE_NORMAL_CHOLESKY;
   solver.max_num_iterations = options.max_iterations;
+  if (std::isfinite(time_limit_s)) solver.max_solver_time_in_seconds = std::max(0.0, time_limit_s);
   solver.num_threads = 1;
   solver.logging_type = ceres::SILENT;
   ceres::Solver::Summary summary;
@@ -328,7 +331,7 @@ ceres::Solver::Summary MapStep(const WindowSnapshot& snapshot, const BackendOpti
       problem.SetParameterBlockConstant(t_bc);
     }
   }
-  return Solve(options, &problem);
+  return Solve(options, state->step_time_limit_s, &problem);
 }
 
 // The pose-update step: the window's poses free with their odometry priors; map and
@@ -399,13 +402,18 @@ ceres::Solver::Summary PoseStep(const WindowSnapshot& snapshot, const BackendOpt
         nullptr, pose.q, pose.t);
     problem.SetManifold(pose.q, new ceres::EigenQuaternionManifold);
   }
-  return Solve(options, &problem);
+  return Solve(options, state->step_time_limit_s, &problem);
 }
 
 }  // namespace
 
-WindowResult SolveWindow(const WindowSnapshot& snapshot, const BackendOptions& options) {
+WindowResult SolveWindow(const WindowSnapshot& snapshot, const BackendOptions& options,
+                         double time_budget_s) {
   const auto start = std::chrono::steady_clock::now();
+  auto remaining_s = [&] {
+    return time_budget_s -
+           std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
+  };
   WindowResult result;
   result.sequence = snapshot.sequence;
   WindowState state(snapshot);
@@ -415,6 +423,8 @@ WindowResult SolveWindow(const WindowSnapshot& snapshot, const BackendOptions& o
   // Map + extrinsic step, then the pose step, `rounds` times.
   bool usable = true;
   auto run = [&](bool map_step) {
+    state.step_time_limit_s = remaining_s();
+    if (!(state.step_time_limit_s > 0.0)) return;  // out of time: the steps so far stand
     int blocks = 0;
     const ceres::Solver::Summary summary = map_step ? MapStep(snapshot, options, &state, &blocks)
                                                     : PoseStep(snapshot, options, &state, &blocks);

@@ -86,12 +86,28 @@ double MarkingAssociationCost(const MarkingElement& element, const MarkingCandid
 std::vector<int> AssociateMarkings(const std::vector<MarkingElement>& elements,
                                    const std::vector<MarkingCandidate>& candidates,
                                    const AssociationOptions& options) {
+  std::vector<const MarkingElement*> pointers;
+  pointers.reserve(elements.size());
+  for (const MarkingElement& e : elements) pointers.push_back(&e);
+  return AssociateMarkings(pointers, candidates, options);
+}
+
+double MarkingGateRadius(const MarkingCandidate& candidate, double max_element_cov_trace,
+                         const AssociationOptions& options) {
+  const double floor = std::pow(MarkingFloorSigma(options), 2);
+  const double trace = candidate.center_cov_map.trace() + max_element_cov_trace + 2.0 * floor;
+  return options.marking_gate_sigmas * std::sqrt(std::max(0.0, trace));
+}
+
+std::vector<int> AssociateMarkings(const std::vector<const MarkingElement*>& elements,
+                                   const std::vector<MarkingCandidate>& candidates,
+                                   const AssociationOptions& options) {
   std::vector<std::tuple<double, int, int>> pairs;
   const double gate = options.marking_gate_sigmas * options.marking_gate_sigmas;
   for (int c = 0; c < static_cast<int>(candidates.size()); ++c) {
     for (int e = 0; e < static_cast<int>(elements.size()); ++e) {
-      if (elements[e].class_id != candidates[c].class_id) continue;
-      const double cost = MarkingAssociationCost(elements[e], candidates[c], options);
+      if (elements[e]->class_id != candidates[c].class_id) continue;
+      const double cost = MarkingAssociationCost(*elements[e], candidates[c], options);
       if (cost <= gate) pairs.emplace_back(cost, c, e);
     }
   }

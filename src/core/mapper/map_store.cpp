@@ -1,6 +1,7 @@
 #include "ipm_road_mapper/core/mapper/map_store.h"
 
 #include <algorithm>
+#include <cmath>
 
 #include "ipm_road_mapper/core/geometry/catmull_rom_spline.h"
 
@@ -44,8 +45,85 @@ void PruneBefore(std::size_t frame, Element* e) {
 
 }  // namespace
 
+MapStore::CellKey MapStore::RetiredCellOf(const Eigen::Vector3d& p_map) const {
+  const auto ix = static_cast<std::int64_t>(std::floor(p_map.x() / kRetiredCellM));
+  const auto iy = static_cast<std::int64_t>(std::floor(p_map.y() / kRetiredCellM));
+  return static_cast<CellKey>((static_cast<std::uint64_t>(ix) << 32) ^
+                              (static_cast<std::uint64_t>(iy) & 0xffffffffULL));
+}
+
+void MapStore::IndexRetired(std::size_t retired_index) {
+  const MarkingElement& m = map_.retired_markings[retired_index];
+  retired_cells_[RetiredCellOf(m.Center())].push_back(retired_index);
+  max_retired_cov_trace_ = std::max(max_retired_cov_trace_, m.center_cov_map.trace());
+}
+
+void MapStore::RetireMarkings(std::size_t first_frame) {
+  std::vector<MarkingElement>& live = map_.markings;
+  std::size_t kept = 0;
+  for (std::size_t i = 0; i < live.size(); ++i) {
+    if (live[i].retired && live[i].last_frame < first_frame) {
+      map_.retired_markings.push_back(std::move(live[i]));
+      IndexRetired(map_.retired_markings.size() - 1);
+    } else {
+      if (kept != i) live[kept] = std::move(live[i]);
+      ++kept;
+    }
+  }
+  live.resize(kept);
+}
+
+std::size_t MapStore::ReviveMarking(std::size_t retired_index) {
+  std::vector<MarkingElement>& retired = map_.retired_markings;
+  map_.markings.push_back(std::move(retired[retired_index]));
+  if (retired_index + 1 != retired.size()) retired[retired_index] = std::move(retired.back());
+  retired.pop_back();
+  ReindexRetiredMarkings();
+  return map_.markings.size() - 1;
+}
+
+void MapStore::ReindexRetiredMarkings() {
+  retired_cells_.clear();
+  max_retired_cov_trace_ = 0.0;
+  for (std::size_t i = 0; i < map_.retired_markings.size(); ++i) IndexRetired(i);
+}
+
+std::vector<std::size_t> MapStore::RetiredMarkingsNear(const Eigen::Vector3d& p_map,
+                                                       double radius_m) const {
+  std::vector<std::size_t> out;
+  if (map_.retired_markings.empty() || !(radius_m >= 0.0) || !p_map.allFinite()) return out;
+  const auto x0 = static_cast<std::int64_t>(std::floor((p_map.x() - radius_m) / kRetiredCellM));
+  const auto x1 = static_cast<std::int64_t>(std::floor((p_map.x() + radius_m) / kRetiredCellM));
+  const auto y0 = static_cast<std::int64_t>(std::floor((p_map.y() - radius_m) / kRetiredCellM));
+  const auto y1 = static_cast<std::int64_t>(std::floor((p_map.y() + radius_m) / kRetiredCellM));
+  auto within = [&](std::size_t i) {
+    return (map_.retired_markings[i].Center() - p_map).head<2>().norm() <= radius_m;
+  };
+  // A disc wider than the map (a huge covariance): a scan is cheaper than its cells.
+  const double cells = (static_cast<double>(x1 - x0) + 1.0) * (static_cast<double>(y1 - y0) + 1.0);
+  if (!(cells <= static_cast<double>(map_.retired_markings.size()))) {
+    for (std::size_t i = 0; i < map_.retired_markings.size(); ++i) {
+      if (within(i)) out.push_back(i);
+    }
+    return out;
+  }
+  for (std::int64_t ix = x0; ix <= x1; ++ix) {
+    for (std::int64_t iy = y0; iy <= y1; ++iy) {
+      const Eigen::Vector3d cell_point((ix + 0.5) * kRetiredCellM, (iy + 0.5) * kRetiredCellM, 0.0);
+      auto it = retired_cells_.find(RetiredCellOf(cell_point));
+      if (it == retired_cells_.end()) continue;
+      for (std::size_t i : it->second) {
+        if (within(i)) out.push_back(i);
+      }
+    }
+  }
+  std::sort(out.begin(), out.end());
+  return out;
+}
+
 void MapStore::PruneHistoriesBefore(std::size_t frame) {
   for (MarkingElement& m : map_.markings) PruneBefore(frame, &m);
+  for (MarkingElement& m : map_.retired_markings) PruneBefore(frame, &m);
   for (LaneElement& l : map_.lanes) PruneBefore(frame, &l);
 }
 
@@ -54,6 +132,8 @@ void MapStore::Clear() {
   map_ = RoadMap();
   map_.next_id = next_id;
   frame_index_.Clear();
+  retired_cells_.clear();
+  max_retired_cov_trace_ = 0.0;
 }
 
 Eigen::Vector3d MapStore::RoadDirectionAt(const Eigen::Vector3d& p_map) const {

@@ -115,7 +115,7 @@ void Mapper::Reset() {
   last_stamp_ = -1.0;
 }
 
-void Mapper::Finish() { windows_.Finish(); }
+bool Mapper::Finish(double time_budget_s) { return windows_.Finish(time_budget_s); }
 
 VectorMap Mapper::ExportMap() const {
   VectorMap out;
@@ -126,7 +126,11 @@ VectorMap Mapper::ExportMap() const {
     return info ? info->name : std::string("class_") + std::to_string(class_id);
   };
   // An element seen once is tentative (a spurious blob, until seen again): not exported.
-  for (const MarkingElement& element : store_.markings()) {
+  std::vector<const MarkingElement*> markings;
+  for (const MarkingElement& m : store_.markings()) markings.push_back(&m);
+  for (const MarkingElement& m : store_.retired_markings()) markings.push_back(&m);
+  for (const MarkingElement* element_ptr : markings) {
+    const MarkingElement& element = *element_ptr;
     if (element.Observations() < 2) continue;
     MapMarking marking;
     marking.id = element.id;

@@ -128,6 +128,7 @@ std::string ToString(const MapperOptions& o) {
   const AssociationOptions gates = EffectiveAssociationOptions(o);
   s << "association floors (with the odometry's " << gates.odometry_sigma_m << " m): marking "
     << MarkingFloorSigma(gates) << " m, lane " << LaneFloorSigma(gates) << " m\n";
+  s << ToString(o.backend);
   return s.str();
 }
 

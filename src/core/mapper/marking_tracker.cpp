@@ -117,8 +117,33 @@ void MarkingTracker::Associate(const std::vector<MarkingObservation>& observatio
     candidate.center_cov_map = R * obs.center_cov_base * R.transpose();
     candidates.push_back(candidate);
   }
+  // The live markings and the retired ones within the gate of some candidate (re-observed
+  // after a gap: a marking is one element however often it is seen).
   std::vector<MarkingElement>& markings = store_->markings();
-  const std::vector<int> match = AssociateMarkings(markings, candidates, options_.association);
+  std::vector<const MarkingElement*> elements;
+  for (const MarkingElement& m : markings) elements.push_back(&m);
+  std::vector<std::size_t> retired_near;
+  for (const MarkingCandidate& c : candidates) {
+    const Eigen::Vector3d center =
+        0.25 * (c.corners_map[0] + c.corners_map[1] + c.corners_map[2] + c.corners_map[3]);
+    const double radius = MarkingGateRadius(c, store_->max_retired_cov_trace(), options_.association);
+    for (std::size_t i : store_->RetiredMarkingsNear(center, radius)) retired_near.push_back(i);
+  }
+  std::sort(retired_near.begin(), retired_near.end());
+  retired_near.erase(std::unique(retired_near.begin(), retired_near.end()), retired_near.end());
+  for (std::size_t i : retired_near) elements.push_back(&store_->retired_markings()[i]);
+  std::vector<int> match = AssociateMarkings(elements, candidates, options_.association);
+  // Matched retired markings come back among the live ones (highest retired index first:
+  // a revival moves the last retired marking into the freed place).
+  const int live_count = static_cast<int>(markings.size());
+  std::vector<std::pair<std::size_t, std::size_t>> revive;  // (retired index, candidate)
+  for (std::size_t c = 0; c < match.size(); ++c) {
+    if (match[c] >= live_count) revive.emplace_back(retired_near[match[c] - live_count], c);
+  }
+  std::sort(revive.rbegin(), revive.rend());
+  for (const auto& [retired_index, c] : revive) {
+    match[c] = static_cast<int>(store_->ReviveMarking(retired_index));
+  }
   for (std::size_t c = 0; c < candidates.size(); ++c) {
     const MarkingObservation& obs = observations[c];
     if (match[c] < 0) {

@@ -1,6 +1,7 @@
 #include "ipm_road_mapper/core/mapper/window_coordinator.h"
 
 #include <algorithm>
+#include <chrono>
 #include <iterator>
 #include <cmath>
 #include <set>
@@ -93,17 +94,38 @@ void WindowCoordinator::Reset() {
 
 void WindowCoordinator::OnFrameUsed(std::uint64_t frames_used, const CameraIntrinsics& camera) {
   camera_ = camera;
-  if (backend_ && frames_used % options_.backend.solve_every_n_frames == 0) {
+  if (frames_used % options_.backend.solve_every_n_frames != 0) return;
+  if (backend_) {
     backend_->Submit(BuildSnapshot());
+    return;
   }
+  // Without a back end the markings that leave the window retire all the same, so that the
+  // front end's per-frame work stays with the live ones.
+  const std::size_t first = WindowStart();
+  for (MarkingElement& m : store_->markings()) {
+    if (m.last_frame < first) m.retired = true;
+  }
+  store_->RetireMarkings(first);
 }
 
-void WindowCoordinator::Finish() {
-  if (!backend_ || store_->frames().empty()) return;
+std::size_t WindowCoordinator::WindowStart() const {
+  const std::size_t window = static_cast<std::size_t>(options_.backend.window_frames);
+  const std::size_t frames = store_->frames().size();
+  return frames > window ? frames - window : 0;
+}
+
+bool WindowCoordinator::Finish(double time_budget_s) {
+  if (!backend_ || store_->frames().empty()) return true;
+  const auto start = std::chrono::steady_clock::now();
+  auto remaining_s = [&] {
+    return time_budget_s -
+           std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
+  };
   backend_->Submit(BuildSnapshot());
-  backend_->WaitIdle();
+  if (!backend_->WaitIdleFor(remaining_s())) return false;  // its result comes later, if ever
   ApplyResults();
-  FinalGlobalSolve();
+  FinalGlobalSolve(remaining_s());
+  return remaining_s() >= 0.0;
 }
 
 double WindowCoordinator::RoadPriorSigma(const RoadSurfaceEstimate& road) const {
@@ -144,7 +166,7 @@ void WindowCoordinator::RetireMarking(MarkingElement* marking) {
                                                 options_.backend.robust_scale));
 }
 
-void WindowCoordinator::FinalGlobalSolve() {
+void WindowCoordinator::FinalGlobalSolve(double time_budget_s) {
   const BackendOptions& o = options_.backend;
   const std::vector<FrameRecord>& frames = store_->frames();
   if (!o.final_global_solve || frames.empty()) return;
@@ -162,7 +184,11 @@ void WindowCoordinator::FinalGlobalSolve() {
   snapshot.extrinsic_prior =
       ExtrinsicPrior(T_base_cam_initial_, o.rotation_prior_sigma_rad, o.translation_prior_sigma_m);
   auto in_span = [start](const auto& measurement) { return measurement.frame_index >= start; };
-  for (const MarkingElement& m : store_->markings()) {
+  std::vector<const MarkingElement*> markings;
+  for (const MarkingElement& m : store_->markings()) markings.push_back(&m);
+  for (const MarkingElement& m : store_->retired_markings()) markings.push_back(&m);
+  for (const MarkingElement* marking : markings) {
+    const MarkingElement& m = *marking;
     if (!m.optimized || m.last_frame < start) continue;
     WindowMarking wm{m.id, m.corners_map, {}, store_->RoadDirectionAt(m.Center()),
                      m.Observations() >= kMinMatureObservations};
@@ -191,25 +217,28 @@ void WindowCoordinator::FinalGlobalSolve() {
   global.max_measurements_per_marking = std::max(o.max_measurements_per_marking, 30);
   global.max_extrinsic_change_rad = 1e9;  // the trust bound guards windows, not this
   global.max_extrinsic_change_m = 1e9;
-  const WindowResult result = SolveWindow(snapshot, global);
+  if (!(time_budget_s > 0.0)) return;
+  const WindowResult result = SolveWindow(snapshot, global, time_budget_s);
   if (!result.usable) {
     ++counters_->results_rejected;
     return;
   }
   ApplyResult(result, /*include_retired=*/true);
+  store_->ReindexRetiredMarkings();  // their corners moved
   ++counters_->results_applied;
 }
 
 WindowSnapshot WindowCoordinator::BuildSnapshot() {
   const std::vector<FrameRecord>& frames = store_->frames();
   const std::size_t window = static_cast<std::size_t>(options_.backend.window_frames);
-  const std::size_t first = frames.size() > window ? frames.size() - window : 0;
+  const std::size_t first = WindowStart();
   // Lanes keep the pixels of one more window of frames as context; older ones retire.
   const std::size_t lane_first = first > window ? first - window : 0;
   for (MarkingElement& m : store_->markings()) {
     if (!m.retired && m.last_frame < first && m.optimized) RetireMarking(&m);
     if (!m.retired && m.last_frame < first) m.retired = true;  // never reached the back end
   }
+  store_->RetireMarkings(first);
   // Lane observations older than that leave the windows. Their information about the
   // extrinsic is not kept: marginalizing pixels of control points that later windows still
   // refine (a lane is never done, its control points are shared along it) made the prior
@@ -287,6 +316,9 @@ void WindowCoordinator::ApplyResult(const WindowResult& result, bool include_ret
   if (options_.backend.optimize_markings) {
     std::unordered_map<std::uint64_t, MarkingElement*> by_id;
     for (MarkingElement& m : store_->markings()) by_id.emplace(m.id, &m);
+    if (include_retired) {
+      for (MarkingElement& m : store_->retired_markings()) by_id.emplace(m.id, &m);
+    }
     for (const WindowMarking& wm : result.markings) {
       auto it = by_id.find(wm.id);
       if (it == by_id.end() || (it->second->retired && !include_retired)) continue;

@@ -44,6 +44,8 @@ class Backend {
 
   // Blocks until every submitted window is solved (end of an offline run).
   void WaitIdle();
+  // The same for at most timeout_s; true when idle.
+  bool WaitIdleFor(double timeout_s);
 
   // Stops the thread (flag + notify + join); waiting windows are discarded. Idempotent.
   void Stop();

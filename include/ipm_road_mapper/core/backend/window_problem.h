@@ -13,6 +13,7 @@
 #include <Eigen/Geometry>
 #include <array>
 #include <cstdint>
+#include <limits>
 #include <string>
 #include <vector>
 
@@ -88,7 +89,10 @@ struct WindowResult {
   std::string summary;  // Ceres BriefReport of the last step
 };
 
-// Builds and solves the window's alternating problem.
-WindowResult SolveWindow(const WindowSnapshot& snapshot, const BackendOptions& options);
+// Builds and solves the window's alternating problem. With a finite time_budget_s, each
+// Ceres step gets what is left of it and no step starts after it has run out (the result is
+// then that of the steps that ran).
+WindowResult SolveWindow(const WindowSnapshot& snapshot, const BackendOptions& options,
+                         double time_budget_s = std::numeric_limits<double>::infinity());
 
 }  // namespace ipm_road_mapper

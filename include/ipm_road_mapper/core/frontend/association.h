@@ -79,6 +79,16 @@ double MarkingAssociationCost(const MarkingElement& element, const MarkingCandid
 std::vector<int> AssociateMarkings(const std::vector<MarkingElement>& elements,
                                    const std::vector<MarkingCandidate>& candidates,
                                    const AssociationOptions& options);
+// The same over elements held elsewhere (e.g. the live ones and the retired ones near the
+// candidates); indices refer to `elements`.
+std::vector<int> AssociateMarkings(const std::vector<const MarkingElement*>& elements,
+                                   const std::vector<MarkingCandidate>& candidates,
+                                   const AssociationOptions& options);
+// A horizontal distance beyond which a candidate's center cannot pass the marking gate of
+// any element whose covariance trace is at most max_element_cov_trace: the gate is
+// d^T S^-1 d <= g^2, so |d|^2 <= g^2 lambda_max(S) <= g^2 tr(S).
+double MarkingGateRadius(const MarkingCandidate& candidate, double max_element_cov_trace,
+                         const AssociationOptions& options);
 
 // A lane observation in the map frame, for association.
 struct LaneCandidate {

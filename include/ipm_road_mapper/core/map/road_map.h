@@ -87,7 +87,10 @@ struct LaneElement {
 // Elements and frames.
 struct RoadMap {
   std::vector<FrameRecord> frames;
+  // The live markings (observed within the window, or not yet moved out of it) and the
+  // retired ones (left the window: their information is in the extrinsic prior).
   std::vector<MarkingElement> markings;
+  std::vector<MarkingElement> retired_markings;
   std::vector<LaneElement> lanes;
   std::uint64_t next_id = 1;
 };

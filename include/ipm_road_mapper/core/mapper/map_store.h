@@ -1,11 +1,14 @@
-// The mapper's map: the frames it used (with a spatial index over their positions) and its
-// elements, and the road-geometry queries that the trackers and the window coordinator
-// share (the road's direction and surface at a point). It owns the data; the trackers and
-// the coordinator change it through the accessors.
+// The mapper's map: the frames it used (with a spatial index over their positions), the live
+// elements, the retired markings (with a spatial index over their centers, so that the front
+// end's per-frame work touches the live elements and a neighbourhood only), and the
+// road-geometry queries that the trackers and the window coordinator share (the road's
+// direction and surface at a point). It owns the data; the trackers and the coordinator
+// change it through the accessors.
 #pragma once
 
 #include <Eigen/Geometry>
 #include <cstdint>
+#include <unordered_map>
 #include <vector>
 
 #include "ipm_road_mapper/core/geometry/road_surface.h"
@@ -25,6 +28,21 @@ class MapStore {
   void SetFramePose(std::size_t index, const Eigen::Isometry3d& T_map_base);
   // A fresh element id.
   std::uint64_t NewId() { return map_.next_id++; }
+  // Moves the live markings flagged `retired` and last seen before `first_frame` into the
+  // retired markings.
+  void RetireMarkings(std::size_t first_frame);
+  // Moves retired marking `retired_index` back among the live ones (re-observed) and returns
+  // its live index. Invalidates retired indices (the last retired one takes its place).
+  std::size_t ReviveMarking(std::size_t retired_index);
+  // Re-indexes the retired markings after their corners changed (the final global solve).
+  void ReindexRetiredMarkings();
+  // Indices of the retired markings whose centers lie within radius_m of p_map (x-y),
+  // sorted.
+  std::vector<std::size_t> RetiredMarkingsNear(const Eigen::Vector3d& p_map,
+                                               double radius_m) const;
+  // The largest trace of a retired marking's center covariance (association's gate radius).
+  double max_retired_cov_trace() const { return max_retired_cov_trace_; }
+
   // Drops the measurements of frames before `frame` from every element's history (counted
   // in `pruned`): what export and association need stays (corners, control points, spans).
   void PruneHistoriesBefore(std::size_t frame);
@@ -35,6 +53,9 @@ class MapStore {
   const std::vector<FrameRecord>& frames() const { return map_.frames; }
   std::vector<MarkingElement>& markings() { return map_.markings; }
   const std::vector<MarkingElement>& markings() const { return map_.markings; }
+  // Markings that left the window (RetireMarkings); the front end looks them up by place.
+  std::vector<MarkingElement>& retired_markings() { return map_.retired_markings; }
+  const std::vector<MarkingElement>& retired_markings() const { return map_.retired_markings; }
   std::vector<LaneElement>& lanes() { return map_.lanes; }
   const std::vector<LaneElement>& lanes() const { return map_.lanes; }
 
@@ -49,9 +70,17 @@ class MapStore {
   static constexpr double kRoadDirectionMaxDistanceM = 8.0;
 
  private:
+  using CellKey = std::int64_t;
+  CellKey RetiredCellOf(const Eigen::Vector3d& p_map) const;
+  void IndexRetired(std::size_t retired_index);
+
   double road_plane_radius_m_;
   RoadMap map_;
   FrameIndex frame_index_;
+  // Retired markings by the grid cell of their center (cells of kRetiredCellM).
+  std::unordered_map<CellKey, std::vector<std::size_t>> retired_cells_;
+  double max_retired_cov_trace_ = 0.0;
+  static constexpr double kRetiredCellM = 10.0;
 };
 
 }  // namespace ipm_road_mapper

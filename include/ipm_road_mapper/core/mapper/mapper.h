@@ -10,6 +10,7 @@
 
 #include <Eigen/Geometry>
 #include <cstdint>
+#include <limits>
 #include <opencv2/core.hpp>
 #include <string>
 
@@ -51,8 +52,11 @@ class Mapper {
   // Counts a frame the caller could not even build (e.g. no odometry at its stamp).
   void CountSkipped(const std::string& reason);
 
-  // End of input: solves the last window, waits for the optimizer and merges its results.
-  void Finish();
+  // End of input: solves the last window, waits for the optimizer, merges its results and
+  // runs the final global solve, within time_budget_s (the nodelet's unload budget; the
+  // offline runner waits for all). True when all of it finished within the budget; the map
+  // is usable either way.
+  bool Finish(double time_budget_s = std::numeric_limits<double>::infinity());
 
   // The map as exported (map.json): every element seen at least twice (one seen once is
   // tentative until seen again or dropped as spurious). Lanes that no lane residual refines

@@ -9,6 +9,7 @@
 
 #include <Eigen/Geometry>
 #include <cstdint>
+#include <limits>
 #include <memory>
 
 #include "ipm_road_mapper/core/backend/backend.h"
@@ -40,8 +41,10 @@ class WindowCoordinator {
   // `camera` is the frame's (the snapshot's camera).
   void OnFrameUsed(std::uint64_t frames_used, const CameraIntrinsics& camera);
   // End of input: solves the last window, waits for it, merges it, then the final global
-  // solve (backend.final_global_solve).
-  void Finish();
+  // solve (backend.final_global_solve), all within time_budget_s: a solve still running
+  // when it runs out is not waited for, and the global solve gets what is left. True when
+  // everything finished within the budget.
+  bool Finish(double time_budget_s = std::numeric_limits<double>::infinity());
   // Drops pending windows (their results belong to the old map) and restarts the Backend.
   // The extrinsic and what is known about it belong to the vehicle: kept.
   void Reset();
@@ -51,12 +54,14 @@ class WindowCoordinator {
   BackendStats stats() const;
 
  private:
+  // The first frame of the current window.
+  std::size_t WindowStart() const;
   WindowSnapshot BuildSnapshot();
   void RetireMarking(MarkingElement* marking);
   // One solve over the whole drive, so that what retired while the extrinsic was still
   // rough (markings, the poses that saw them) gets the final extrinsic, and the windows'
   // alternation converges where it was slow.
-  void FinalGlobalSolve();
+  void FinalGlobalSolve(double time_budget_s);
   // Merges a result into the map; retired markings only with include_retired (the final
   // global solve: a window's late result must not move what its prior already holds).
   void ApplyResult(const WindowResult& result, bool include_retired);
