@@ -5,6 +5,22 @@
 #include <utility>
 
 namespace ipm_road_mapper {
+namespace {
+
+// TEMPORARY until the lead's Mapper::Finish(double time_budget_s) is merged: calls it when
+// the Mapper has it, else the 0-argument Finish() (which ignores the budget). Remove with
+// the merge and call mapper.Finish(time_budget_s) directly.
+template <typename M>
+auto FinishWithin(M& mapper, double time_budget_s, int)
+    -> decltype(mapper.Finish(time_budget_s), void()) {
+  mapper.Finish(time_budget_s);
+}
+template <typename M>
+void FinishWithin(M& mapper, double /*time_budget_s*/, long) {
+  mapper.Finish();
+}
+
+}  // namespace
 
 MappingSession::MappingSession(MapperOptions options, ClassTable classes, double odometry_wait_s)
     : options_(std::move(options)),
@@ -88,7 +104,7 @@ void MappingSession::Process(std::vector<FrameInput> frames, std::vector<std::st
   }
 }
 
-void MappingSession::Finish(SessionUpdate* update) {
+void MappingSession::Finish(SessionUpdate* update, double time_budget_s) {
   std::vector<std::string> skipped;
   std::vector<FrameInput> ready = assembler_.Flush(&skipped);
   if (!mapper_) {
@@ -96,7 +112,7 @@ void MappingSession::Finish(SessionUpdate* update) {
     return;
   }
   Process(std::move(ready), std::move(skipped), update);
-  mapper_->Finish();
+  FinishWithin(*mapper_, time_budget_s, 0);
 }
 
 void MappingSession::Reset() {

@@ -22,9 +22,9 @@ void MapperNodelet::onInit() {
   SetUpOutputs();
   SetUpInputs();
   NODELET_INFO("%s: waiting for %s (+ %s) and %s; %s sync", node_name_.c_str(),
-               config_.mapper.input.mask_topic.c_str(),
-               config_.mapper.input.camera_info_topic.c_str(),
-               config_.mapper.input.odom_topic.c_str(), config_.mapper.input.sync.c_str());
+               config_.ros.mask_topic.c_str(),
+               config_.ros.camera_info_topic.c_str(),
+               config_.ros.odom_topic.c_str(), config_.ros.sync.c_str());
 }
 
 void MapperNodelet::LoadParameters() {
@@ -54,7 +54,7 @@ void MapperNodelet::SetUpOutputs() {
   map_publisher_ = std::make_unique<MapPublisher>(private_nh, config_.ros.path_max_poses);
   corrected_odom_pub_ = private_nh.advertise<nav_msgs::Odometry>("corrected_odom", 10);
   debug_image_ = std::make_unique<DebugImagePublisher>(
-      nh, private_nh, config_.mapper.input.image_topic, config_.mapper, classes_);
+      nh, private_nh, config_.ros.image_topic, config_.mapper, classes_);
   diagnostics_ = std::make_unique<MapperDiagnostics>(nh, private_nh, node_name_,
                                                      [this] { return Snapshot(); });
   save_srv_ = output_nh.advertiseService("save_map", &MapperNodelet::OnSaveMap, this);
@@ -72,7 +72,7 @@ void MapperNodelet::SetUpOutputs() {
 
 void MapperNodelet::SetUpInputs() {
   ros::NodeHandle& nh = getNodeHandle();
-  const InputOptions& input = config_.mapper.input;
+  const RosOptions& input = config_.ros;
   const int queue = config_.ros.sync_queue_size;
   tf_buffer_ = std::make_unique<tf2_ros::Buffer>();
   tf_listener_ = std::make_unique<tf2_ros::TransformListener>(*tf_buffer_, nh);

@@ -9,6 +9,7 @@
 
 #include <Eigen/Geometry>
 #include <cstdint>
+#include <limits>
 #include <map>
 #include <memory>
 #include <optional>
@@ -16,9 +17,9 @@
 #include <vector>
 
 #include "ipm_road_mapper/core/frontend/class_table.h"
-#include "ipm_road_mapper/pipeline/frame_assembler.h"
 #include "ipm_road_mapper/core/mapper/mapper.h"
 #include "ipm_road_mapper/core/mapper/mapper_options.h"
+#include "ipm_road_mapper/pipeline/frame_assembler.h"
 
 namespace ipm_road_mapper {
 
@@ -53,8 +54,10 @@ class MappingSession {
   // Counts a frame the caller could not build (bad encoding, no camera_info, ...).
   void CountSkipped(const std::string& reason, SessionUpdate* update);
 
-  // End of input: decides every waiting frame, then Mapper::Finish (last window solved).
-  void Finish(SessionUpdate* update);
+  // End of input: decides every waiting frame, then Mapper::Finish(time_budget_s) (the last
+  // window solved, in at most about `time_budget_s` of wall time; infinity = no limit).
+  void Finish(SessionUpdate* update,
+              double time_budget_s = std::numeric_limits<double>::infinity());
 
   // Drops the map and every waiting frame and pose; options, extrinsic and counters stay.
   void Reset();
