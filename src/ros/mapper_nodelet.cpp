@@ -110,11 +110,11 @@ void MapperNodelet::SetUpOutputs() {
 
 void MapperNodelet::SetUpInputs() {
   ros::NodeHandle& nh = getNodeHandle();
-  const RosOptions& input = config_.ros;
+  const RosOptions& topics = config_.ros;
   const int queue = config_.ros.sync_queue_size;
   tf_listener_ = std::make_unique<tf2_ros::TransformListener>(*tf_buffer_, nh);
-  mask_sub_.subscribe(nh, input.mask_topic, queue);
-  info_sub_.subscribe(nh, input.camera_info_topic, queue);
+  mask_sub_.subscribe(nh, topics.mask_topic, queue);
+  info_sub_.subscribe(nh, topics.camera_info_topic, queue);
   mask_sub_.registerCallback(boost::function<void(const sensor_msgs::ImageConstPtr&)>(
       [this](const sensor_msgs::ImageConstPtr&) { diagnostics_->Count(MapperInput::kMask); }));
   info_sub_.registerCallback(boost::function<void(const sensor_msgs::CameraInfoConstPtr&)>(
@@ -123,7 +123,7 @@ void MapperNodelet::SetUpInputs() {
       }));
   using boost::placeholders::_1;
   using boost::placeholders::_2;
-  if (input.sync == "approximate") {
+  if (topics.sync == "approximate") {
     ApproximatePolicy policy(queue);
     policy.setMaxIntervalDuration(ros::Duration(config_.ros.approximate_sync_max_interval_s));
     approximate_sync_ = std::make_unique<message_filters::Synchronizer<ApproximatePolicy>>(
@@ -134,8 +134,8 @@ void MapperNodelet::SetUpInputs() {
         ExactPolicy(queue), mask_sub_, info_sub_);
     exact_sync_->registerCallback(boost::bind(&MapperNodelet::OnFrame, this, _1, _2));
   }
-  odom_sub_ =
-      nh.subscribe(input.odom_topic, config_.ros.odom_queue_size, &MapperNodelet::OnOdometry, this);
+  odom_sub_ = nh.subscribe(topics.odom_topic, config_.ros.odom_queue_size,
+                           &MapperNodelet::OnOdometry, this);
 }
 
 void MapperNodelet::OnFrame(const sensor_msgs::ImageConstPtr& mask_msg,
