@@ -346,9 +346,11 @@ void MapperNodelet::SaveAtShutdown(std::chrono::steady_clock::time_point deadlin
   } else {
     NODELET_ERROR("%s", message.c_str());
   }
-  // After ros::shutdown (a manager or mapper_node exiting), roscpp's logging may be gone:
-  // the result still reaches the console.
-  if (!ros::ok()) std::fprintf(stderr, "[%s] %s\n", node_name_.c_str(), message.c_str());
+  // Once ros::shutdown began (a manager or mapper_node exiting on SIGINT), rosconsole is
+  // shut down and the line above prints nothing: the result still reaches the console.
+  if (ros::isShuttingDown() || !ros::ok()) {
+    std::fprintf(stderr, "[%s] %s\n", node_name_.c_str(), message.c_str());
+  }
 }
 
 }  // namespace ipm_road_mapper
