@@ -4,7 +4,7 @@
 // Mapper, and every frame that cannot be used is counted by reason. The Mapper is created
 // when the rough extrinsic is known (Start); frames before that are counted as
 // `no_extrinsic` and the counts are handed to the Mapper when it starts. No ROS header, not
-// thread-safe: the nodelet holds its own mutex around every call.
+// thread-safe: the nodelet calls it from its mapping thread only (MappingWorker).
 #pragma once
 
 #include <Eigen/Geometry>
