@@ -21,10 +21,19 @@ std::string CheckFrameName(const std::string& v) {
   return "";
 }
 
+std::string CheckNonEmpty(const std::string& v) { return v.empty() ? "must not be empty" : ""; }
+
 }  // namespace
 
 RosOptions LoadRosOptions(OptionsReader reader) {
   RosOptions o;
+  reader.Read<std::string>("mask_topic", &o.mask_topic, CheckNonEmpty);
+  reader.Read<std::string>("camera_info_topic", &o.camera_info_topic, CheckNonEmpty);
+  reader.Read<std::string>("image_topic", &o.image_topic);
+  reader.Read<std::string>("odom_topic", &o.odom_topic, CheckNonEmpty);
+  reader.Read<std::string>("sync", &o.sync, [](const std::string& v) -> std::string {
+    return v == "exact" || v == "approximate" ? "" : "must be exact or approximate";
+  });
   reader.Read<double>("publish_rate_hz", &o.publish_rate_hz, [](const double& v) {
     return v > 0.0 && v <= 100.0 ? "" : "must be in (0, 100] Hz";
   });
@@ -40,6 +49,9 @@ RosOptions LoadRosOptions(OptionsReader reader) {
   reader.Read<int>("path_max_poses", &o.path_max_poses, CheckPositiveInt);
   reader.Read<double>("diagnostics_period_s", &o.diagnostics_period_s, CheckPositive);
   reader.Read<double>("debug_image_rate_hz", &o.debug_image_rate_hz, CheckPositive);
+  reader.Read<int>("input_queue_size", &o.input_queue_size, CheckQueueSize);
+  reader.Read<double>("marker_full_period_s", &o.marker_full_period_s, CheckPositive);
+  reader.Read<double>("shutdown_budget_s", &o.shutdown_budget_s, CheckPositive);
   reader.RejectUnknownKeys();
   return o;
 }
@@ -52,6 +64,14 @@ MapperConfig LoadMapperConfig(OptionsReader reader) {
   // were read, so it rejects only keys that nobody asked for.
   config.mapper = LoadMapperOptions(reader);
   return config;
+}
+
+std::string CheckLiveConfig(const MapperConfig& config) {
+  if (config.mapper.backend.synchronous) {
+    return "backend.synchronous: true is for the offline runner only: the live nodelet would "
+           "run every solve in its mapping thread and stall the input (set it false)";
+  }
+  return "";
 }
 
 MapperConfig LoadMapperConfigFile(const std::string& path) {
@@ -68,7 +88,12 @@ std::string ToString(const RosOptions& o) {
   auto or_default = [](const std::string& v, const char* fallback) {
     return v.empty() ? std::string(fallback) : v;
   };
-  s << "ros.publish_rate_hz: " << o.publish_rate_hz << "\n"
+  s << "ros.mask_topic: " << o.mask_topic << "\n"
+    << "ros.camera_info_topic: " << o.camera_info_topic << "\n"
+    << "ros.image_topic: " << or_default(o.image_topic, "(none)") << "\n"
+    << "ros.odom_topic: " << o.odom_topic << "\n"
+    << "ros.sync: " << o.sync << "\n"
+    << "ros.publish_rate_hz: " << o.publish_rate_hz << "\n"
     << "ros.map_frame: " << or_default(o.map_frame, "(odometry header.frame_id)") << "\n"
     << "ros.refined_camera_frame: " << or_default(o.refined_camera_frame, "(<camera>_refined)")
     << "\n"
@@ -80,7 +105,10 @@ std::string ToString(const RosOptions& o) {
     << "ros.odometry_wait_s: " << o.odometry_wait_s << "\n"
     << "ros.path_max_poses: " << o.path_max_poses << "\n"
     << "ros.diagnostics_period_s: " << o.diagnostics_period_s << "\n"
-    << "ros.debug_image_rate_hz: " << o.debug_image_rate_hz << "\n";
+    << "ros.debug_image_rate_hz: " << o.debug_image_rate_hz << "\n"
+    << "ros.input_queue_size: " << o.input_queue_size << "\n"
+    << "ros.marker_full_period_s: " << o.marker_full_period_s << "\n"
+    << "ros.shutdown_budget_s: " << o.shutdown_budget_s << "\n";
   return s.str();
 }
 

@@ -5,7 +5,6 @@
 #include <utility>
 
 namespace ipm_road_mapper {
-
 MappingSession::MappingSession(MapperOptions options, ClassTable classes, double odometry_wait_s)
     : options_(std::move(options)),
       classes_(std::move(classes)),
@@ -88,7 +87,7 @@ void MappingSession::Process(std::vector<FrameInput> frames, std::vector<std::st
   }
 }
 
-void MappingSession::Finish(SessionUpdate* update) {
+void MappingSession::Finish(SessionUpdate* update, double time_budget_s) {
   std::vector<std::string> skipped;
   std::vector<FrameInput> ready = assembler_.Flush(&skipped);
   if (!mapper_) {
@@ -96,7 +95,7 @@ void MappingSession::Finish(SessionUpdate* update) {
     return;
   }
   Process(std::move(ready), std::move(skipped), update);
-  mapper_->Finish();
+  mapper_->Finish(time_budget_s);
 }
 
 void MappingSession::Reset() {

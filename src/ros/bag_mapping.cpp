@@ -95,15 +95,15 @@ class BagMapping {
 
 }  // namespace
 
-std::size_t MapBag(const rosbag::Bag& bag, const InputOptions& input, MappingSession* session,
+std::size_t MapBag(const rosbag::Bag& bag, const RosOptions& topics, MappingSession* session,
                    const BagMappingCallbacks& callbacks) {
   CameraInfoPairing pairing(
-      CameraInfoTable(CameraInfoTable::ToleranceFromFirstMessages(bag, input.camera_info_topic)),
-      input.sync == "exact");
+      CameraInfoTable(CameraInfoTable::ToleranceFromFirstMessages(bag, topics.camera_info_topic)),
+      topics.sync == "exact");
   BagMapping mapping(session, callbacks);
   std::vector<PairedMask> paired;
   {
-    BagPrefetcher prefetcher(bag, {input.mask_topic, input.odom_topic, input.camera_info_topic});
+    BagPrefetcher prefetcher(bag, {topics.mask_topic, topics.odom_topic, topics.camera_info_topic});
     BagPrefetcher::Item message;
     while (prefetcher.Next(&message)) {
       switch (message.kind) {

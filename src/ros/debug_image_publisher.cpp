@@ -34,13 +34,15 @@ cv::Mat ImageToCv(const sensor_msgs::ImageConstPtr& image) {
 
 }  // namespace
 
-DebugImagePublisher::DebugImagePublisher(ros::NodeHandle& nh, ros::NodeHandle& private_nh,
-                                         std::string image_topic, MapperOptions options,
-                                         ClassTable classes)
+DebugImagePublisher::DebugImagePublisher(
+    ros::NodeHandle& nh, ros::NodeHandle& private_nh, std::string image_topic,
+    MapperOptions options, ClassTable classes,
+    std::function<void(const sensor_msgs::ImageConstPtr&)> enqueue)
     : nh_(nh),
       image_topic_(std::move(image_topic)),
       options_(std::move(options)),
-      classes_(std::move(classes)) {
+      classes_(std::move(classes)),
+      enqueue_(std::move(enqueue)) {
   const ros::SubscriberStatusCallback on_connection =
       [this](const ros::SingleSubscriberPublisher&) { OnConnection(); };
   std::lock_guard<std::mutex> lock(mutex_);
@@ -61,7 +63,7 @@ void DebugImagePublisher::Shutdown() {
     pending_.reset();
     images_.clear();
   }
-  // Outside the lock: shutdown() waits for a running OnImage, which takes the lock.
+  // Outside the lock: shutdown() waits for a running image callback.
   old.shutdown();
   pub.shutdown();
 }
@@ -79,7 +81,7 @@ void DebugImagePublisher::OnConnection() {
     const bool wanted = pub_.getNumSubscribers() > 0;
     if (wanted && !image_sub_ && !image_topic_.empty()) {
       image_sub_ = nh_.subscribe<sensor_msgs::Image>(
-          image_topic_, 5, [this](const sensor_msgs::ImageConstPtr& image) { OnImage(image); });
+          image_topic_, 5, [this](const sensor_msgs::ImageConstPtr& image) { enqueue_(image); });
       last_image_wall_ = ros::WallTime::now();  // give the image topic time to start
     } else if (!wanted && image_sub_) {
       old = std::move(image_sub_);
@@ -111,7 +113,7 @@ void DebugImagePublisher::AddFrame(const FrameInput& frame, const Eigen::Isometr
   Draw(job, image);
 }
 
-void DebugImagePublisher::OnImage(const sensor_msgs::ImageConstPtr& image) {
+void DebugImagePublisher::AddImage(const sensor_msgs::ImageConstPtr& image) {
   std::optional<PendingFrame> job;
   {
     std::lock_guard<std::mutex> lock(mutex_);

@@ -8,19 +8,32 @@
 
 namespace ipm_road_mapper {
 
-MapPublisher::MapPublisher(ros::NodeHandle& private_nh, int path_max_poses)
-    : path_max_poses_(path_max_poses) {
+MapPublisher::MapPublisher(ros::NodeHandle& private_nh, int path_max_poses,
+                           double marker_full_period_s)
+    : path_max_poses_(path_max_poses), marker_full_period_(marker_full_period_s) {
   vector_map_pub_ = private_nh.advertise<ipm_road_mapper::VectorMapMsg>("vector_map", 1, true);
-  markers_pub_ = private_nh.advertise<visualization_msgs::MarkerArray>("markers", 1, true);
+  // A new subscriber gets the latched last message (maybe a delta), then the full set.
+  const ros::SubscriberStatusCallback on_connect = [this](const ros::SingleSubscriberPublisher&) {
+    new_marker_subscriber_ = true;
+  };
+  markers_pub_ = private_nh.advertise<visualization_msgs::MarkerArray>(
+      "markers", 1, on_connect, ros::SubscriberStatusCallback(), ros::VoidConstPtr(), true);
   path_pub_ = private_nh.advertise<nav_msgs::Path>("corrected_path", 1, true);
 }
 
 void MapPublisher::Publish(const VectorMap& map, const std::string& map_frame,
                            const std::string& base_frame, const std::string& refined_camera_frame,
-                           const ros::Time& stamp) {
+                           const ros::Time& stamp, bool map_changed) {
   std::lock_guard<std::mutex> lock(mutex_);
+  const ros::WallTime now = ros::WallTime::now();
+  const bool full = new_marker_subscriber_.exchange(false) || last_full_markers_.isZero() ||
+                    now - last_full_markers_ >= marker_full_period_;
+  if (full) last_full_markers_ = now;
+  const visualization_msgs::MarkerArray markers = markers_.Build(
+      map, map_frame, stamp, full ? MarkerBuilder::Mode::kFull : MarkerBuilder::Mode::kChanges);
+  if (!markers.markers.empty()) markers_pub_.publish(markers);
+  if (!map_changed) return;
   vector_map_pub_.publish(ToVectorMapMsg(map, map_frame, stamp));
-  markers_pub_.publish(markers_.Build(map, map_frame, stamp));
   path_pub_.publish(ToPathMsg(map.trajectory, map_frame, path_max_poses_, stamp));
   const bool changed = !last_T_base_cam_ || !last_T_base_cam_->isApprox(map.T_base_cam, 1e-12);
   if (changed) {
@@ -28,6 +41,12 @@ void MapPublisher::Publish(const VectorMap& map, const std::string& map_frame,
         IsometryToTransformStamped(map.T_base_cam, stamp, base_frame, refined_camera_frame));
     last_T_base_cam_ = map.T_base_cam;
   }
+}
+
+bool MapPublisher::full_markers_due() const {
+  std::lock_guard<std::mutex> lock(mutex_);
+  return new_marker_subscriber_ || last_full_markers_.isZero() ||
+         ros::WallTime::now() - last_full_markers_ >= marker_full_period_;
 }
 
 void MapPublisher::Clear(const std::string& map_frame, const ros::Time& stamp) {

@@ -65,14 +65,26 @@ void FillFrameStatus(const MapperStatusSnapshot& now, const MapperStatusSnapshot
   s->add("odometry bad", now.assembler.bad_odometry);
   s->add("odometry out of order", now.assembler.odometry_out_of_order);
   s->add("time jumps", now.assembler.time_jumps);
-  s->addf("callback time mean (ms)", "%.2f", now.callback_mean_ms);
-  s->addf("callback time max (ms)", "%.2f", now.callback_max_ms);
-  s->addf("frame callback time mean (ms)", "%.2f", now.frame_callback_mean_ms);
-  s->addf("frame callback time max (ms)", "%.2f", now.frame_callback_max_ms);
+  s->addf("callback time mean (ms)", "%.3f", now.callback_mean_ms);
+  s->addf("callback time max (ms)", "%.3f", now.callback_max_ms);
+  s->addf("frame callback time mean (ms)", "%.3f", now.frame_callback_mean_ms);
+  s->addf("frame callback time max (ms)", "%.3f", now.frame_callback_max_ms);
+  s->add("inputs dropped (queue full): frames", now.inputs_dropped[0]);
+  s->add("inputs dropped (queue full): odometry", now.inputs_dropped[1]);
+  s->add("inputs dropped (queue full): images", now.inputs_dropped[2]);
+  s->add("publishes", now.publishes);
+  s->addf("publish_cpu_ms", "%.3f", now.publish_cpu_last_ms);
+  s->addf("publish_cpu_ms mean", "%.3f", now.publish_cpu_mean_ms);
+  s->addf("publish_cpu_ms max", "%.3f", now.publish_cpu_max_ms);
   const std::uint64_t new_used = used - std::min(used, previous.counters.frames_used);
   const std::uint64_t new_skipped =
       skipped_total - std::min(skipped_total, Total(AllSkipped(previous)));
-  if (new_used == 0 && new_skipped > 0) {
+  const auto dropped = [](const MapperStatusSnapshot& x) {
+    return x.inputs_dropped[0] + x.inputs_dropped[1] + x.inputs_dropped[2];
+  };
+  if (dropped(now) > dropped(previous)) {
+    s->summary(DiagnosticStatus::WARN, "inputs dropped: the mapping thread falls behind");
+  } else if (new_used == 0 && new_skipped > 0) {
     s->summary(DiagnosticStatus::WARN, "frames skipped, none used");
   } else if (new_skipped > 0) {
     s->summary(DiagnosticStatus::OK, "mapping (some frames skipped)");

@@ -2,29 +2,62 @@
 
 #include <ros/package.h>
 #include <tf2/exceptions.h>
+#include <time.h>
 
 #include <boost/bind/bind.hpp>
+#include <cstdio>
 #include <limits>
 #include <pluginlib/class_list_macros.hpp>
 #include <utility>
 
-#include "ipm_road_mapper/pipeline/extrinsic_source.h"
 #include "ipm_road_mapper/pipeline/map_files.h"
 #include "ipm_road_mapper/ros/msg_conversion.h"
 #include "ipm_road_mapper/ros/param_bridge.h"
 
 namespace ipm_road_mapper {
+namespace {
+
+constexpr double kResetTimeoutS = 2.0;
+
+// CPU time of the calling thread (ms): what one publication costs, whatever else runs.
+double ThreadCpuMs() {
+  timespec t{};
+  clock_gettime(CLOCK_THREAD_CPUTIME_ID, &t);
+  return 1e3 * static_cast<double>(t.tv_sec) + 1e-6 * static_cast<double>(t.tv_nsec);
+}
+
+}  // namespace
+
 MapperNodelet::~MapperNodelet() { Shutdown(); }
 
 void MapperNodelet::onInit() {
   node_name_ = getName();
   LoadParameters();  // throws on a bad parameter: the manager reports the failed load
+  tf_buffer_ = std::make_unique<tf2_ros::Buffer>();
+  const TransformLookup lookup = [this](const std::string& parent, const std::string& child,
+                                        Eigen::Isometry3d* T) -> std::string {
+    try {  // ros::Time(0): the latest transform, no waiting
+      return TransformToIsometry(tf_buffer_->lookupTransform(parent, child, ros::Time(0)).transform,
+                                 T);
+    } catch (const tf2::TransformException& e) {
+      return e.what();
+    }
+  };
+  MappingWorker::Hooks hooks;
+  hooks.on_update = [this](const SessionUpdate& update, const FrameOutputs& outputs) {
+    AfterUpdate(update, outputs);
+  };
+  hooks.on_image = [this](const sensor_msgs::ImageConstPtr& image) {
+    if (debug_image_) debug_image_->AddImage(image);
+  };
+  hooks.overlay_wanted = [this] { return debug_image_ && debug_image_->active(); };
+  // The mapping thread starts idle; inputs reach it only once SetUpInputs subscribed.
+  worker_ = std::make_unique<MappingWorker>(config_, classes_, node_name_, lookup, hooks);
   SetUpOutputs();
   SetUpInputs();
   NODELET_INFO("%s: waiting for %s (+ %s) and %s; %s sync", node_name_.c_str(),
-               config_.mapper.input.mask_topic.c_str(),
-               config_.mapper.input.camera_info_topic.c_str(),
-               config_.mapper.input.odom_topic.c_str(), config_.mapper.input.sync.c_str());
+               config_.ros.mask_topic.c_str(), config_.ros.camera_info_topic.c_str(),
+               config_.ros.odom_topic.c_str(), config_.ros.sync.c_str());
 }
 
 void MapperNodelet::LoadParameters() {
@@ -40,8 +73,11 @@ void MapperNodelet::LoadParameters() {
     NODELET_FATAL("invalid parameter %s: %s", private_nh.getNamespace().c_str(), e.what());
     throw;
   }
-  session_ =
-      std::make_unique<MappingSession>(config_.mapper, classes_, config_.ros.odometry_wait_s);
+  const std::string live_error = CheckLiveConfig(config_);
+  if (!live_error.empty()) {
+    NODELET_FATAL("%s: refusing to map: %s", private_nh.getNamespace().c_str(), live_error.c_str());
+    throw OptionsError(live_error);
+  }
   NODELET_INFO_STREAM("ipm_road_mapper options:\n"
                       << ToString(config_.mapper) << ToString(config_.ros));
 }
@@ -51,10 +87,12 @@ void MapperNodelet::SetUpOutputs() {
   ros::NodeHandle& private_nh = getPrivateNodeHandle();
   ros::NodeHandle output_nh(private_nh);  // timers and services on our own queue
   output_nh.setCallbackQueue(&output_queue_);
-  map_publisher_ = std::make_unique<MapPublisher>(private_nh, config_.ros.path_max_poses);
+  map_publisher_ = std::make_unique<MapPublisher>(private_nh, config_.ros.path_max_poses,
+                                                  config_.ros.marker_full_period_s);
   corrected_odom_pub_ = private_nh.advertise<nav_msgs::Odometry>("corrected_odom", 10);
   debug_image_ = std::make_unique<DebugImagePublisher>(
-      nh, private_nh, config_.mapper.input.image_topic, config_.mapper, classes_);
+      nh, private_nh, config_.ros.image_topic, config_.mapper, classes_,
+      [this](const sensor_msgs::ImageConstPtr& image) { OnImage(image); });
   diagnostics_ = std::make_unique<MapperDiagnostics>(nh, private_nh, node_name_,
                                                      [this] { return Snapshot(); });
   save_srv_ = output_nh.advertiseService("save_map", &MapperNodelet::OnSaveMap, this);
@@ -72,12 +110,11 @@ void MapperNodelet::SetUpOutputs() {
 
 void MapperNodelet::SetUpInputs() {
   ros::NodeHandle& nh = getNodeHandle();
-  const InputOptions& input = config_.mapper.input;
+  const RosOptions& topics = config_.ros;
   const int queue = config_.ros.sync_queue_size;
-  tf_buffer_ = std::make_unique<tf2_ros::Buffer>();
   tf_listener_ = std::make_unique<tf2_ros::TransformListener>(*tf_buffer_, nh);
-  mask_sub_.subscribe(nh, input.mask_topic, queue);
-  info_sub_.subscribe(nh, input.camera_info_topic, queue);
+  mask_sub_.subscribe(nh, topics.mask_topic, queue);
+  info_sub_.subscribe(nh, topics.camera_info_topic, queue);
   mask_sub_.registerCallback(boost::function<void(const sensor_msgs::ImageConstPtr&)>(
       [this](const sensor_msgs::ImageConstPtr&) { diagnostics_->Count(MapperInput::kMask); }));
   info_sub_.registerCallback(boost::function<void(const sensor_msgs::CameraInfoConstPtr&)>(
@@ -86,7 +123,7 @@ void MapperNodelet::SetUpInputs() {
       }));
   using boost::placeholders::_1;
   using boost::placeholders::_2;
-  if (input.sync == "approximate") {
+  if (topics.sync == "approximate") {
     ApproximatePolicy policy(queue);
     policy.setMaxIntervalDuration(ros::Duration(config_.ros.approximate_sync_max_interval_s));
     approximate_sync_ = std::make_unique<message_filters::Synchronizer<ApproximatePolicy>>(
@@ -97,132 +134,66 @@ void MapperNodelet::SetUpInputs() {
         ExactPolicy(queue), mask_sub_, info_sub_);
     exact_sync_->registerCallback(boost::bind(&MapperNodelet::OnFrame, this, _1, _2));
   }
-  odom_sub_ =
-      nh.subscribe(input.odom_topic, config_.ros.odom_queue_size, &MapperNodelet::OnOdometry, this);
-}
-
-bool MapperNodelet::EnsureStartedLocked(const std::string& camera_frame) {
-  if (session_->started()) return true;
-  const TransformLookup lookup = [this](const std::string& parent, const std::string& child,
-                                        Eigen::Isometry3d* T) -> std::string {
-    try {  // ros::Time(0): the latest transform, no waiting
-      return TransformToIsometry(tf_buffer_->lookupTransform(parent, child, ros::Time(0)).transform,
-                                 T);
-    } catch (const tf2::TransformException& e) {
-      return e.what();
-    }
-  };
-  ExtrinsicChoice choice;
-  const std::string error =
-      ChooseExtrinsic(config_.mapper.input, camera_frame, lookup, "tf", &choice);
-  if (!error.empty()) {
-    extrinsic_status_ = error;
-    NODELET_WARN_THROTTLE(5.0, "%s (frames are skipped until it is known)", error.c_str());
-    return false;
-  }
-  camera_frame_ = camera_frame.empty() ? std::string("camera") : camera_frame;
-  refined_frame_ = config_.ros.refined_camera_frame.empty() ? camera_frame_ + "_refined"
-                                                            : config_.ros.refined_camera_frame;
-  if (refined_frame_ == camera_frame_) {
-    NODELET_ERROR(
-        "ros/refined_camera_frame is the camera frame %s: publishing it would give "
-        "that frame a second parent; using %s_refined instead",
-        camera_frame_.c_str(), camera_frame_.c_str());
-    refined_frame_ = camera_frame_ + "_refined";
-  }
-  session_->Start(choice.T_base_cam);
-  extrinsic_status_ = choice.source;
-  NODELET_INFO("rough extrinsic from %s; refined extrinsic published as %s -> %s",
-               choice.source.c_str(), config_.mapper.input.base_frame.c_str(),
-               refined_frame_.c_str());
-  return true;
+  odom_sub_ = nh.subscribe(topics.odom_topic, config_.ros.odom_queue_size,
+                           &MapperNodelet::OnOdometry, this);
 }
 
 void MapperNodelet::OnFrame(const sensor_msgs::ImageConstPtr& mask_msg,
                             const sensor_msgs::CameraInfoConstPtr& info_msg) {
   const auto start = std::chrono::steady_clock::now();
   diagnostics_->Count(MapperInput::kPair);
-  cv::Mat mask;
-  const std::string mask_error = ImageToMask(*mask_msg, &mask);
-  CameraIntrinsics camera;
-  const std::string info_error = CameraInfoToIntrinsics(*info_msg, &camera);
-  SessionUpdate update;
-  UpdateOutputs outputs;
-  {
-    std::lock_guard<std::mutex> lock(mutex_);
-    if (shutting_down_) return;
-    if (!mask_error.empty()) {
-      session_->CountSkipped("bad_mask_encoding: " + mask_error, &update);
-    } else if (!info_error.empty()) {
-      session_->CountSkipped("bad_camera_info: " + info_error, &update);
-    } else if (!EnsureStartedLocked(mask_msg->header.frame_id)) {
-      session_->CountSkipped("no_extrinsic: " + extrinsic_status_, &update);
-    } else {
-      session_->AddFrame(ToSeconds(mask_msg->header.stamp), std::move(mask), camera, &update);
-    }
-    outputs = CollectLocked(update);
+  if (shutting_down_) return;
+  FrameItem frame;
+  frame.stamp = ToSeconds(mask_msg->header.stamp);
+  frame.camera_frame = mask_msg->header.frame_id;
+  const std::string mask_error = ImageToMask(*mask_msg, &frame.mask);
+  const std::string info_error = CameraInfoToIntrinsics(*info_msg, &frame.camera);
+  if (!mask_error.empty()) {
+    frame.error = "bad_mask_encoding: " + mask_error;
+  } else if (!info_error.empty()) {
+    frame.error = "bad_camera_info: " + info_error;
   }
-  AfterUpdate(update, outputs);
-  RecordCallbackTime(start, update.used.size());
+  worker_->Push(std::move(frame));
+  RecordCallbackTime(start, true);
 }
 
 void MapperNodelet::OnOdometry(const nav_msgs::OdometryConstPtr& msg) {
   const auto start = std::chrono::steady_clock::now();
   diagnostics_->Count(MapperInput::kOdometry);
-  StampedPose pose;
-  const std::string error = OdometryToStampedPose(*msg, &pose);
+  if (shutting_down_) return;
+  OdometryItem odometry;
+  odometry.frame_id = msg->header.frame_id;
+  const std::string error = OdometryToStampedPose(*msg, &odometry.pose);
   if (!error.empty()) {
     // Handed on as a NaN pose, so the assembler counts it as bad_odometry (as map_from_bag).
     NODELET_WARN_THROTTLE(5.0, "bad odometry: %s", error.c_str());
-    pose.stamp = ToSeconds(msg->header.stamp);
-    pose.T_map_base.matrix().setConstant(std::numeric_limits<double>::quiet_NaN());
+    odometry.pose.stamp = ToSeconds(msg->header.stamp);
+    odometry.pose.T_map_base.matrix().setConstant(std::numeric_limits<double>::quiet_NaN());
   }
-  SessionUpdate update;
-  UpdateOutputs outputs;
-  {
-    std::lock_guard<std::mutex> lock(mutex_);
-    if (shutting_down_) return;
-    if (map_frame_.empty()) {
-      map_frame_ = !config_.ros.map_frame.empty()  ? config_.ros.map_frame
-                   : !msg->header.frame_id.empty() ? msg->header.frame_id
-                                                   : std::string("map");
-    }
-    session_->AddOdometry(pose, &update);
-    outputs = CollectLocked(update);
-  }
-  AfterUpdate(update, outputs);
-  RecordCallbackTime(start, update.used.size());
+  worker_->Push(std::move(odometry));
+  RecordCallbackTime(start, false);
 }
 
-MapperNodelet::UpdateOutputs MapperNodelet::CollectLocked(const SessionUpdate& update) {
-  UpdateOutputs outputs;
-  if (!update.used.empty()) {
-    const Mapper& mapper = *session_->mapper();
-    outputs.T_map_base = mapper.map().frames.back().T_map_base;
-    outputs.T_base_cam = mapper.T_base_cam();
-    last_frame_stamp_ = update.used.back().stamp;
-    ++changes_;
-    // The overlay draws the map as of its frame: one export, throttled, only when watched.
-    const auto now = std::chrono::steady_clock::now();
-    if (debug_image_ && debug_image_->active() &&
-        std::chrono::duration<double>(now - last_overlay_).count() >=
-            1.0 / config_.ros.debug_image_rate_hz) {
-      last_overlay_ = now;
-      if (std::optional<VectorMap> map = ExportLocked()) {
-        outputs.overlay_map = std::make_shared<const VectorMap>(std::move(*map));
-      }
-    }
-  }
-  outputs.map_frame = map_frame_.empty() ? "map" : map_frame_;
-  outputs.base_frame = config_.mapper.input.base_frame;
-  return outputs;
+void MapperNodelet::OnImage(const sensor_msgs::ImageConstPtr& image) {
+  diagnostics_->Count(MapperInput::kImage);
+  if (!shutting_down_) worker_->Push(ImageItem{image});
 }
 
-void MapperNodelet::AfterUpdate(const SessionUpdate& update, const UpdateOutputs& outputs) {
-  for (const std::string& reason : update.skipped) {
-    NODELET_WARN_THROTTLE(5.0, "frame skipped: %s", reason.c_str());
+void MapperNodelet::RecordCallbackTime(std::chrono::steady_clock::time_point start, bool frame) {
+  const double ms =
+      std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - start).count();
+  std::lock_guard<std::mutex> lock(stats_mutex_);
+  ++callbacks_;
+  callback_total_ms_ += ms;
+  callback_max_ms_ = std::max(callback_max_ms_, ms);
+  if (frame) {
+    ++frame_callbacks_;
+    frame_callback_total_ms_ += ms;
+    frame_callback_max_ms_ = std::max(frame_callback_max_ms_, ms);
   }
-  if (update.used.empty()) return;
+}
+
+void MapperNodelet::AfterUpdate(const SessionUpdate& update, const FrameOutputs& outputs) {
   nav_msgs::Odometry odom;
   odom.header.stamp = FromSeconds(update.used.back().stamp);
   odom.header.frame_id = outputs.map_frame;
@@ -235,70 +206,41 @@ void MapperNodelet::AfterUpdate(const SessionUpdate& update, const UpdateOutputs
   }
 }
 
-void MapperNodelet::RecordCallbackTime(std::chrono::steady_clock::time_point start,
-                                       std::size_t used_frames) {
-  const double ms =
-      std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - start).count();
-  std::lock_guard<std::mutex> lock(mutex_);
-  ++callbacks_;
-  callback_total_ms_ += ms;
-  callback_max_ms_ = std::max(callback_max_ms_, ms);
-  if (used_frames > 0) {
-    ++frame_callbacks_;
-    frame_callback_total_ms_ += ms;
-    frame_callback_max_ms_ = std::max(frame_callback_max_ms_, ms);
-  }
-}
-
-std::optional<VectorMap> MapperNodelet::ExportLocked() const {
-  if (!session_ || !session_->started()) return std::nullopt;
-  VectorMap map = session_->mapper()->ExportMap();
-  map.frame_id = map_frame_.empty() ? "map" : map_frame_;
-  map.metadata["source"] = "ipm_road_mapper/MapperNodelet " + node_name_;
-  map.metadata["extrinsic_source"] = extrinsic_status_;
-  return map;
-}
-
 void MapperNodelet::OnPublishTimer() {
-  std::shared_ptr<const VectorMap> map;
-  std::string base_frame, refined_frame;
-  ros::Time stamp;
-  {
-    std::lock_guard<std::mutex> lock(mutex_);
-    if (shutting_down_ || changes_ == published_changes_) return;
-    std::optional<VectorMap> exported = ExportLocked();
-    if (!exported) return;
-    map = std::make_shared<const VectorMap>(std::move(*exported));
-    published_changes_ = changes_;
-    base_frame = config_.mapper.input.base_frame;
-    refined_frame = refined_frame_;
-    stamp = FromSeconds(last_frame_stamp_);
-  }
-  map_publisher_->Publish(*map, map->frame_id, base_frame, refined_frame, stamp);
+  if (shutting_down_) return;
+  const std::shared_ptr<const MapSnapshot> snapshot = worker_->Latest();
+  if (!snapshot->map) return;
+  const bool changed = snapshot->map_version != published_version_;
+  if (!changed && !map_publisher_->full_markers_due()) return;
+  published_version_ = snapshot->map_version;
+  const double cpu_start_ms = ThreadCpuMs();
+  map_publisher_->Publish(*snapshot->map, snapshot->map_frame, config_.mapper.input.base_frame,
+                          snapshot->refined_camera_frame, FromSeconds(snapshot->newest_frame_stamp),
+                          changed);
+  const double cpu_ms = ThreadCpuMs() - cpu_start_ms;
+  std::lock_guard<std::mutex> lock(stats_mutex_);
+  ++publishes_;
+  publish_cpu_last_ms_ = cpu_ms;
+  publish_cpu_total_ms_ += cpu_ms;
+  publish_cpu_max_ms_ = std::max(publish_cpu_max_ms_, cpu_ms);
 }
 
 bool MapperNodelet::OnSaveMap(ipm_road_mapper::SaveMap::Request& request,
                               ipm_road_mapper::SaveMap::Response& response) {
-  std::optional<VectorMap> map;
-  std::string status;
-  {
-    std::lock_guard<std::mutex> lock(mutex_);
-    map = ExportLocked();
-    status = extrinsic_status_;
-  }
+  const std::shared_ptr<const MapSnapshot> snapshot = worker_->Latest();
   response.success = false;
   if (request.path.empty()) {
     response.message = "path is empty";
-  } else if (!map) {
-    response.message =
-        "no map yet: " + (status.empty() ? std::string("no frame received") : status);
+  } else if (!snapshot->map) {
+    response.message = "no map yet: " + snapshot->status.extrinsic_status;
   } else {
+    const VectorMap& map = *snapshot->map;
     const MapFilePaths paths = MapFilePathsFor(request.path);
     try {
-      SaveMapFiles(*map, config_.geo_origin, paths);
+      SaveMapFiles(map, config_.geo_origin, paths);
       response.success = true;
-      response.message = "wrote " + std::to_string(map->markings.size()) + " markings and " +
-                         std::to_string(map->lanes.size()) + " lanes to " + paths.json + ", " +
+      response.message = "wrote " + std::to_string(map.markings.size()) + " markings and " +
+                         std::to_string(map.lanes.size()) + " lanes to " + paths.json + ", " +
                          paths.geojson + ", " + paths.tum;
     } catch (const std::exception& e) {
       response.message = e.what();
@@ -313,50 +255,41 @@ bool MapperNodelet::OnSaveMap(ipm_road_mapper::SaveMap::Request& request,
 }
 
 bool MapperNodelet::OnReset(std_srvs::Trigger::Request&, std_srvs::Trigger::Response& response) {
-  std::string map_frame;
-  {
-    std::lock_guard<std::mutex> lock(mutex_);
-    session_->Reset();
-    ++changes_;
-    map_frame = map_frame_.empty() ? "map" : map_frame_;
+  response.success = worker_->Reset(kResetTimeoutS, &response.message);
+  if (!response.success) {
+    NODELET_WARN("reset: %s", response.message.c_str());
+    return true;
   }
-  map_publisher_->Clear(map_frame, ros::Time::now());
-  response.success = true;
-  response.message = "map, waiting frames and odometry cleared";
+  map_publisher_->Clear(worker_->Latest()->map_frame, ros::Time::now());
+  published_version_ = worker_->Latest()->map_version;
   NODELET_INFO("reset: %s", response.message.c_str());
   return true;
 }
 
 MapperStatusSnapshot MapperNodelet::Snapshot() {
-  std::lock_guard<std::mutex> lock(mutex_);
-  MapperStatusSnapshot s;
-  if (!session_) return s;
-  s.started = session_->started();
-  s.extrinsic_status = extrinsic_status_.empty() ? "no frame yet" : extrinsic_status_;
-  s.skipped_before_start = session_->skipped_before_start();
-  s.assembler = session_->assembler().counters();
-  if (const Mapper* mapper = session_->mapper()) {
-    s.counters = mapper->counters();
-    s.backend_enabled = mapper->options().backend.enabled;
-    s.backend = mapper->backend_stats();
-    s.T_base_cam_initial = mapper->T_base_cam_initial();
-    s.T_base_cam = mapper->T_base_cam();
-  }
+  MapperStatusSnapshot s = worker_->Latest()->status;
+  s.inputs_dropped = worker_->dropped();
+  std::lock_guard<std::mutex> lock(stats_mutex_);
   s.callbacks = callbacks_;
   s.callback_mean_ms = callbacks_ ? callback_total_ms_ / callbacks_ : 0.0;
   s.callback_max_ms = callback_max_ms_;
   s.frame_callback_mean_ms = frame_callbacks_ ? frame_callback_total_ms_ / frame_callbacks_ : 0.0;
   s.frame_callback_max_ms = frame_callback_max_ms_;
+  s.publishes = publishes_;
+  s.publish_cpu_last_ms = publish_cpu_last_ms_;
+  s.publish_cpu_mean_ms = publishes_ ? publish_cpu_total_ms_ / publishes_ : 0.0;
+  s.publish_cpu_max_ms = publish_cpu_max_ms_;
   return s;
 }
 
 void MapperNodelet::Shutdown() {
-  {
-    std::lock_guard<std::mutex> lock(mutex_);
-    shutting_down_ = true;
-  }
+  const auto deadline = std::chrono::steady_clock::now() +
+                        std::chrono::duration_cast<std::chrono::steady_clock::duration>(
+                            std::chrono::duration<double>(config_.ros.shutdown_budget_s));
+  shutting_down_ = true;
+  if (worker_) worker_->CloseInputs();  // a waiting ~reset answers at once
   // Stop everything that calls into this object; each call waits for a running callback
-  // (none of them is called with mutex_ held, so a callback waiting for it can finish).
+  // (none of them waits for the mapping thread longer than the ~reset time-out).
   publish_timer_.stop();
   diagnostics_timer_.stop();
   save_srv_.shutdown();
@@ -366,45 +299,58 @@ void MapperNodelet::Shutdown() {
   info_sub_.unsubscribe();
   if (debug_image_) debug_image_->Shutdown();
   if (output_spinner_) output_spinner_->stop();  // joins the output thread
-  std::optional<VectorMap> final_map;
-  {
-    std::lock_guard<std::mutex> lock(mutex_);
-    if (session_ && session_->started() && !config_.ros.save_map_path.empty()) {
-      session_->Finish(nullptr);  // waiting frames decided, the last window solved
-      final_map = ExportLocked();
-    }
-    if (callbacks_ > 0) {
-      NODELET_INFO(
-          "%s: %lu data callbacks, %.2f ms mean, %.2f ms max; %lu ran frames through "
-          "the mapper, %.2f ms mean, %.2f ms max",
-          node_name_.c_str(), static_cast<unsigned long>(callbacks_),
-          callback_total_ms_ / callbacks_, callback_max_ms_,
-          static_cast<unsigned long>(frame_callbacks_),
-          frame_callbacks_ ? frame_callback_total_ms_ / frame_callbacks_ : 0.0,
-          frame_callback_max_ms_);
-    }
-  }
-  if (final_map) {
-    try {
-      SaveMapFiles(*final_map, config_.geo_origin, MapFilePathsFor(config_.ros.save_map_path));
-      NODELET_INFO("map saved at shutdown: %s (%zu markings, %zu lanes)",
-                   config_.ros.save_map_path.c_str(), final_map->markings.size(),
-                   final_map->lanes.size());
-    } catch (const std::exception& e) {
-      NODELET_ERROR("cannot save the map at shutdown: %s", e.what());
-    }
+  if (worker_ && !config_.ros.save_map_path.empty()) SaveAtShutdown(deadline);
+  if (worker_) worker_->Stop();  // joins the mapping thread
+  if (callbacks_ > 0) {
+    NODELET_INFO(
+        "%s: %lu data callbacks, %.3f ms mean, %.3f ms max; %lu publications, %.2f ms CPU "
+        "mean, %.2f ms max",
+        node_name_.c_str(), static_cast<unsigned long>(callbacks_), callback_total_ms_ / callbacks_,
+        callback_max_ms_, static_cast<unsigned long>(publishes_),
+        publishes_ ? publish_cpu_total_ms_ / publishes_ : 0.0, publish_cpu_max_ms_);
   }
   exact_sync_.reset();
   approximate_sync_.reset();
-  {
-    std::lock_guard<std::mutex> lock(mutex_);
-    session_.reset();  // the Mapper's optimizer thread is stopped and joined here
-  }
+  worker_.reset();  // the session: the Mapper's optimizer thread is stopped and joined here
   tf_listener_.reset();
   tf_buffer_.reset();
   diagnostics_.reset();
   debug_image_.reset();
   map_publisher_.reset();
+}
+
+void MapperNodelet::SaveAtShutdown(std::chrono::steady_clock::time_point deadline) {
+  bool finished = false;
+  const std::shared_ptr<const VectorMap> map = worker_->Finish(deadline, &finished);
+  const std::string& path = config_.ros.save_map_path;
+  std::string message;
+  bool ok = false;
+  if (!map) {
+    message = "nothing to save at shutdown: " + worker_->Latest()->status.extrinsic_status;
+  } else {
+    try {
+      SaveMapFiles(*map, config_.geo_origin, MapFilePathsFor(path));
+      ok = true;
+      message = "map saved at shutdown: " + path + " (" + std::to_string(map->markings.size()) +
+                " markings, " + std::to_string(map->lanes.size()) + " lanes; " +
+                (finished ? "finished map"
+                          : "the last solve ran past ros/shutdown_budget_s: "
+                            "latest snapshot") +
+                ")";
+    } catch (const std::exception& e) {
+      message = std::string("cannot save the map at shutdown: ") + e.what();
+    }
+  }
+  if (ok) {
+    NODELET_INFO("%s", message.c_str());
+  } else {
+    NODELET_ERROR("%s", message.c_str());
+  }
+  // Once ros::shutdown began (a manager or mapper_node exiting on SIGINT), rosconsole is
+  // shut down and the line above prints nothing: the result still reaches the console.
+  if (ros::isShuttingDown() || !ros::ok()) {
+    std::fprintf(stderr, "[%s] %s\n", node_name_.c_str(), message.c_str());
+  }
 }
 
 }  // namespace ipm_road_mapper

@@ -3,6 +3,7 @@
 #include <array>
 #include <cstdint>
 #include <exception>
+#include <functional>
 #include <vector>
 
 #include "ipm_road_mapper/core/geometry/catmull_rom_spline.h"
@@ -51,6 +52,30 @@ std::vector<Eigen::Vector3d> LaneSamples(const MapLane& lane, double spacing_m) 
   }
 }
 
+void HashCombine(std::size_t* seed, std::size_t value) {
+  *seed ^= value + 0x9e3779b97f4a7c15ull + (*seed << 6) + (*seed >> 2);
+}
+
+void HashPoint(std::size_t* seed, const Eigen::Vector3d& p) {
+  for (int i = 0; i < 3; ++i) HashCombine(seed, std::hash<double>()(p[i]));
+}
+
+// What a lane's markers depend on: class and control points.
+std::size_t Fingerprint(const MapLane& lane) {
+  std::size_t seed = std::hash<int>()(lane.class_id);
+  HashCombine(&seed, std::hash<std::string>()(lane.class_name));
+  for (const Eigen::Vector3d& c : lane.control_points_map) HashPoint(&seed, c);
+  return seed;
+}
+
+// What a marking's markers depend on: class and corners.
+std::size_t Fingerprint(const MapMarking& marking) {
+  std::size_t seed = std::hash<int>()(marking.class_id);
+  HashCombine(&seed, std::hash<std::string>()(marking.class_name));
+  for (const Eigen::Vector3d& c : marking.corners_map) HashPoint(&seed, c);
+  return seed;
+}
+
 }  // namespace
 
 std_msgs::ColorRGBA ClassColor(int class_id, const std::string& class_name) {
@@ -78,40 +103,61 @@ MarkerBuilder::MarkerBuilder(double lane_sample_spacing_m)
 
 visualization_msgs::MarkerArray MarkerBuilder::Build(const VectorMap& map,
                                                      const std::string& frame_id,
-                                                     const ros::Time& stamp) {
+                                                     const ros::Time& stamp, Mode mode) {
   using visualization_msgs::Marker;
   visualization_msgs::MarkerArray out;
-  std::set<std::pair<std::string, int>> now;
+  std::map<MarkerKey, std::size_t> now;
+  std::size_t fingerprint = 0;
   auto add = [&](Marker marker) {
-    now.insert({marker.ns, marker.id});
+    now[{marker.ns, marker.id}] = fingerprint;
     out.markers.push_back(std::move(marker));
   };
+  // kChanges: an element drawn before with the same fingerprint keeps its markers as sent.
+  auto unchanged = [&](const char* ns_a, const char* ns_b, int id) {
+    if (mode != Mode::kChanges) return false;
+    bool any = false, same = true;
+    for (const char* ns : {ns_a, ns_b}) {
+      const auto it = published_.find({ns, id});
+      if (it == published_.end()) continue;
+      any = true;
+      same = same && it->second == fingerprint;
+    }
+    if (!any || !same) return false;
+    for (const char* ns : {ns_a, ns_b}) {
+      const auto it = published_.find({ns, id});
+      if (it != published_.end()) now.insert(*it);
+    }
+    return true;
+  };
   for (const MapLane& lane : map.lanes) {
+    const int id = MarkerId(lane.id);
+    fingerprint = Fingerprint(lane);
+    if (unchanged(kLaneNs, kControlPointNs, id)) continue;
     const std_msgs::ColorRGBA color = ClassColor(lane.class_id, lane.class_name);
-    Marker line = NewMarker(kLaneNs, MarkerId(lane.id), Marker::LINE_STRIP, frame_id, stamp);
+    Marker line = NewMarker(kLaneNs, id, Marker::LINE_STRIP, frame_id, stamp);
     line.scale.x = 0.15;  // line width, m (a painted lane line)
     line.color = color;
     for (const Eigen::Vector3d& p : LaneSamples(lane, lane_sample_spacing_m_)) {
       line.points.push_back(ToPointMsg(p));
     }
     if (line.points.size() >= 2) add(line);
-    Marker points =
-        NewMarker(kControlPointNs, MarkerId(lane.id), Marker::SPHERE_LIST, frame_id, stamp);
+    Marker points = NewMarker(kControlPointNs, id, Marker::SPHERE_LIST, frame_id, stamp);
     points.scale.x = points.scale.y = points.scale.z = 0.3;
     points.color = Rgba(color.r * 0.6f, color.g * 0.6f, color.b * 0.6f + 0.4f);
     for (const Eigen::Vector3d& c : lane.control_points_map) points.points.push_back(ToPointMsg(c));
     if (!points.points.empty()) add(points);
   }
   for (const MapMarking& marking : map.markings) {
+    const int id = MarkerId(marking.id);
+    fingerprint = Fingerprint(marking);
+    if (unchanged(kMarkingNs, kLabelNs, id)) continue;
     const std_msgs::ColorRGBA color = ClassColor(marking.class_id, marking.class_name);
-    Marker outline =
-        NewMarker(kMarkingNs, MarkerId(marking.id), Marker::LINE_STRIP, frame_id, stamp);
+    Marker outline = NewMarker(kMarkingNs, id, Marker::LINE_STRIP, frame_id, stamp);
     outline.scale.x = 0.08;
     outline.color = color;
     for (int i = 0; i <= 4; ++i) outline.points.push_back(ToPointMsg(marking.corners_map[i % 4]));
     add(outline);
-    Marker label =
-        NewMarker(kLabelNs, MarkerId(marking.id), Marker::TEXT_VIEW_FACING, frame_id, stamp);
+    Marker label = NewMarker(kLabelNs, id, Marker::TEXT_VIEW_FACING, frame_id, stamp);
     label.pose.position = ToPointMsg(marking.Center() + Eigen::Vector3d(0.0, 0.0, 0.5));
     label.scale.z = 0.6;  // text height, m
     label.color = color;
@@ -119,9 +165,9 @@ visualization_msgs::MarkerArray MarkerBuilder::Build(const VectorMap& map,
                                             : marking.class_name;
     add(label);
   }
-  for (const auto& [ns, id] : published_) {
-    if (now.count({ns, id})) continue;
-    Marker gone = NewMarker(ns, id, Marker::LINE_STRIP, frame_id, stamp);
+  for (const auto& [key, unused] : published_) {
+    if (now.count(key)) continue;
+    Marker gone = NewMarker(key.first, key.second, Marker::LINE_STRIP, frame_id, stamp);
     gone.action = Marker::DELETE;
     out.markers.push_back(gone);
   }

@@ -111,11 +111,11 @@ MapperConfig LoadConfig(const std::string& path) {
 
 // The rough extrinsic and where it came from (ChooseExtrinsic, as the nodelet decides it).
 Eigen::Isometry3d FindExtrinsic(const rosbag::Bag& bag, const InputOptions& input,
-                                std::string* source) {
+                                const std::string& mask_topic, std::string* source) {
   std::string camera_frame;
   if (!input.T_base_cam) {
-    rosbag::View masks(bag, rosbag::TopicQuery(input.mask_topic));
-    if (masks.size() == 0) throw InputError("topic " + input.mask_topic + " has no message");
+    rosbag::View masks(bag, rosbag::TopicQuery(mask_topic));
+    if (masks.size() == 0) throw InputError("topic " + mask_topic + " has no message");
     const auto first = masks.begin()->instantiate<sensor_msgs::Image>();
     camera_frame = first ? first->header.frame_id : "";
   }
@@ -249,13 +249,15 @@ int Run(int argc, char** argv) {
     throw InputError(args.bag + ": cannot read bag: " + e.what());
   }
   const InputOptions& input = options.input;
+  const RosOptions& topics = config.ros;  // the bag's topic names and sync, as the nodelet's
   const std::string topic_error =
-      CheckBagTopics(bag, {{input.mask_topic, "sensor_msgs/Image"},
-                           {input.camera_info_topic, "sensor_msgs/CameraInfo"},
-                           {input.odom_topic, "nav_msgs/Odometry"}});
+      CheckBagTopics(bag, {{topics.mask_topic, "sensor_msgs/Image"},
+                           {topics.camera_info_topic, "sensor_msgs/CameraInfo"},
+                           {topics.odom_topic, "nav_msgs/Odometry"}});
   if (!topic_error.empty()) throw InputError(args.bag + ": " + topic_error);
   RunStats stats;
-  const Eigen::Isometry3d T_base_cam = FindExtrinsic(bag, input, &stats.extrinsic_source);
+  const Eigen::Isometry3d T_base_cam =
+      FindExtrinsic(bag, input, topics.mask_topic, &stats.extrinsic_source);
   std::error_code dir_error;
   fs::create_directories(args.out, dir_error);
   if (dir_error || !fs::is_directory(args.out)) {
@@ -269,10 +271,10 @@ int Run(int argc, char** argv) {
   MappingSession session(options, classes);
   session.Start(T_base_cam);
   // Counts and span from the bag's index (no message is read).
-  rosbag::View span_view(bag, rosbag::TopicQuery({input.mask_topic, input.odom_topic}));
-  const std::size_t total_masks = rosbag::View(bag, rosbag::TopicQuery(input.mask_topic)).size();
+  rosbag::View span_view(bag, rosbag::TopicQuery({topics.mask_topic, topics.odom_topic}));
+  const std::size_t total_masks = rosbag::View(bag, rosbag::TopicQuery(topics.mask_topic)).size();
   const std::size_t total_camera_infos =
-      rosbag::View(bag, rosbag::TopicQuery(input.camera_info_topic)).size();
+      rosbag::View(bag, rosbag::TopicQuery(topics.camera_info_topic)).size();
   std::cerr << "map_from_bag: " << total_masks << " masks, " << total_camera_infos
             << " camera_infos; extrinsic from " << stats.extrinsic_source << "\n";
 
@@ -287,7 +289,7 @@ int Run(int argc, char** argv) {
     stats.startup_s = SecondsSinceProcessStart();
     std::fprintf(stderr, "map_from_bag: first frame mapped after %.3f s\n", *stats.startup_s);
   };
-  stats.frames_read = MapBag(bag, input, &session, callbacks);
+  stats.frames_read = MapBag(bag, topics, &session, callbacks);
   progress.Finish();
   stats.wall_s = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
   stats.bag_span_s = (span_view.getEndTime() - span_view.getBeginTime()).toSec();

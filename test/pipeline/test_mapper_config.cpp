@@ -28,7 +28,7 @@ std::string ErrorOf(const std::string& yaml) {
 TEST(MapperConfig, PackageConfigsLoadAndRosYamlStatesTheDefaults) {
   const std::string dir = std::string(IRM_SOURCE_DIR) + "/config/";
   const MapperConfig config = LoadMapperConfigFile(dir + "mapper.yaml");
-  EXPECT_EQ(config.mapper.input.sync, "exact");
+  EXPECT_EQ(config.ros.sync, "exact");
   EXPECT_FALSE(config.geo_origin.has_value());
   // The ablation configs overlay it (base:) and load as well.
   EXPECT_NO_THROW(LoadMapperConfigFile(dir + "ablations/ipm.yaml"));
@@ -60,6 +60,46 @@ TEST(MapperConfig, RosSectionIsTypedAndValidated) {
   EXPECT_NE(ErrorOf("bogus: 1").find("bogus"), std::string::npos);  // core keys still checked
   EXPECT_NE(ErrorOf("ipm: {max_range_m: -3}").find("ipm.max_range_m"), std::string::npos);
   EXPECT_FALSE(ToString(config.ros).empty());
+}
+
+TEST(MapperConfig, TopicsAndSyncAreRosOptions) {
+  const MapperConfig config = Load(
+      "ros: {mask_topic: /m, camera_info_topic: /ci, image_topic: '', odom_topic: /o, "
+      "sync: approximate}");
+  EXPECT_EQ(config.ros.mask_topic, "/m");
+  EXPECT_EQ(config.ros.camera_info_topic, "/ci");
+  EXPECT_EQ(config.ros.image_topic, "");
+  EXPECT_EQ(config.ros.odom_topic, "/o");
+  EXPECT_EQ(config.ros.sync, "approximate");
+  EXPECT_NE(ErrorOf("ros: {sync: sometimes}").find("ros.sync"), std::string::npos);
+  EXPECT_NE(ErrorOf("ros: {mask_topic: ''}").find("ros.mask_topic"), std::string::npos);
+  // They left the core's input section: an old config says where they went (unknown key).
+  EXPECT_NE(ErrorOf("input: {mask_topic: /m}").find("input.mask_topic"), std::string::npos);
+  EXPECT_NE(ErrorOf("input: {sync: exact}").find("input.sync"), std::string::npos);
+}
+
+TEST(MapperConfig, ThreadingOptionsAreValidated) {
+  const RosOptions defaults;
+  EXPECT_DOUBLE_EQ(defaults.shutdown_budget_s, 3.0);
+  EXPECT_DOUBLE_EQ(Load("ros: {shutdown_budget_s: 0.5}").ros.shutdown_budget_s, 0.5);
+  EXPECT_NE(ErrorOf("ros: {shutdown_budget_s: 0}").find("ros.shutdown_budget_s"),
+            std::string::npos);
+  EXPECT_NE(ErrorOf("ros: {shutdown_budget_s: -1}").find("ros.shutdown_budget_s"),
+            std::string::npos);
+  EXPECT_NE(ErrorOf("ros: {input_queue_size: 0}").find("ros.input_queue_size"), std::string::npos);
+  EXPECT_NE(ErrorOf("ros: {marker_full_period_s: 0}").find("ros.marker_full_period_s"),
+            std::string::npos);
+}
+
+TEST(MapperConfig, LiveNodeletRefusesASynchronousBackend) {
+  EXPECT_EQ(CheckLiveConfig(Load("")), "");
+  const std::string error = CheckLiveConfig(Load("backend: {synchronous: true}"));
+  EXPECT_NE(error.find("backend.synchronous"), std::string::npos);
+  EXPECT_NE(error.find("stall"), std::string::npos);
+  // The package's config runs live.
+  EXPECT_EQ(
+      CheckLiveConfig(LoadMapperConfigFile(std::string(IRM_SOURCE_DIR) + "/config/mapper.yaml")),
+      "");
 }
 
 TEST(MapFiles, NamesAndWriting) {

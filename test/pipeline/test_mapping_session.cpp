@@ -4,6 +4,8 @@
 // lagging but present odometry never triggers it; reset keeps mapping.
 #include <gtest/gtest.h>
 
+#include <chrono>
+
 #include "common/test_scene.h"
 #include "ipm_road_mapper/pipeline/mapping_session.h"
 
@@ -131,6 +133,25 @@ TEST(MappingSession, ResetKeepsMapping) {
   session.AddFrame(0.02, EmptyMask(), Camera(), &update);
   session.AddOdometry(Pose(0.1), &update);
   EXPECT_EQ(update.used.size(), 1u);
+}
+
+TEST(MappingSession, FinishWithATimeBudgetDecidesTheWaitingFramesAndSolves) {
+  MapperOptions options = Options();
+  options.backend.enabled = true;  // the optimizer thread, as in the nodelet
+  MappingSession session(options, Classes());
+  session.Finish(nullptr, 1.0);  // before Start: nothing to do, no crash
+  session.Start(Extrinsic());
+  SessionUpdate update;
+  session.AddOdometry(Pose(0.0), &update);
+  for (int i = 1; i <= 5; ++i) session.AddFrame(0.02 * i, EmptyMask(), Camera(), &update);
+  EXPECT_EQ(session.assembler().pending_frames(), 5u);
+  const auto start = std::chrono::steady_clock::now();
+  session.Finish(&update, 2.0);
+  const double elapsed_s =
+      std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
+  EXPECT_EQ(session.assembler().pending_frames(), 0u);
+  EXPECT_EQ(update.used.size() + update.skipped.size(), 5u);
+  EXPECT_LT(elapsed_s, 2.0 + 1.0);  // five empty frames: far inside the budget
 }
 
 }  // namespace

@@ -101,7 +101,8 @@ class BagMappingTest : public ::testing::Test {
 TEST_F(BagMappingTest, EveryMaskIsOneFrameInBagOrder) {
   MapperOptions options;
   options.backend.enabled = false;
-  options.input.sync = "exact";
+  RosOptions topics;
+  topics.sync = "exact";
   MappingSession session(options, Classes());
   session.Start(Extrinsic());
   std::vector<std::size_t> frames;
@@ -117,7 +118,7 @@ TEST_F(BagMappingTest, EveryMaskIsOneFrameInBagOrder) {
     ++first_frame_reports;
     frames_before_first = frames.size();
   };
-  const std::size_t read = MapBag(bag_, options.input, &session, callbacks);
+  const std::size_t read = MapBag(bag_, topics, &session, callbacks);
 
   EXPECT_EQ(read, static_cast<std::size_t>(kMasks));
   ASSERT_EQ(frames.size(), static_cast<std::size_t>(kMasks));
@@ -138,7 +139,7 @@ TEST_F(BagMappingTest, WorksWithoutCallbacks) {
   options.backend.enabled = false;
   MappingSession session(options, Classes());
   session.Start(Extrinsic());
-  EXPECT_EQ(MapBag(bag_, options.input, &session, {}), static_cast<std::size_t>(kMasks));
+  EXPECT_EQ(MapBag(bag_, RosOptions(), &session, {}), static_cast<std::size_t>(kMasks));
   EXPECT_EQ(session.mapper()->counters().frames_used, static_cast<std::uint64_t>(kMasks - 2));
 }
 

@@ -110,7 +110,8 @@ class MapperBagTest(unittest.TestCase):
         cls.manager = irm.Manager("/manager")
         fe_params = irm.load_config(**{"backend/enabled": False,
                                        "ros/save_map_path": cls.out + "/live_fe/map.json",
-                                       "ros/sync_queue_size": 200})
+                                       "ros/sync_queue_size": 200,
+                                       "ros/input_queue_size": 5000})
         assert cls.manager.load("/mapper_fe", fe_params), "cannot load /mapper_fe"
         for name in ("/mapper", "/mapper_fe"):
             rospy.wait_for_service(name + "/save_map", timeout=60)

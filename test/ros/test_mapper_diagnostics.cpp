@@ -49,6 +49,36 @@ TEST(MapperDiagnostics, SkipReasonsAndSyncDrops) {
   EXPECT_EQ(warn.level, DiagnosticStatus::WARN);
 }
 
+TEST(MapperDiagnostics, QueueDropsWarnAndPublishCpuIsShown) {
+  MapperStatusSnapshot previous, now;
+  now.started = true;
+  now.counters.frames_used = 50;
+  previous = now;
+  previous.counters.frames_used = 40;
+  now.inputs_dropped = {2, 7, 0};
+  now.publishes = 12;
+  now.publish_cpu_last_ms = 0.25;
+  now.publish_cpu_mean_ms = 0.2;
+  now.publish_cpu_max_ms = 0.5;
+  DiagnosticStatusWrapper s;
+  FillFrameStatus(now, previous, Flowing(), &s);
+  EXPECT_EQ(Value(s, "inputs dropped (queue full): frames"), "2");
+  EXPECT_EQ(Value(s, "inputs dropped (queue full): odometry"), "7");
+  EXPECT_EQ(Value(s, "inputs dropped (queue full): images"), "0");
+  EXPECT_EQ(Value(s, "publishes"), "12");
+  EXPECT_EQ(Value(s, "publish_cpu_ms"), "0.250");
+  EXPECT_EQ(Value(s, "publish_cpu_ms mean"), "0.200");
+  EXPECT_EQ(Value(s, "publish_cpu_ms max"), "0.500");
+  EXPECT_EQ(s.level, DiagnosticStatus::WARN);  // drops during the period
+  EXPECT_NE(s.message.find("falls behind"), std::string::npos);
+  // No new drop in the next period: OK again.
+  previous = now;
+  now.counters.frames_used = 60;
+  DiagnosticStatusWrapper ok;
+  FillFrameStatus(now, previous, Flowing(), &ok);
+  EXPECT_EQ(ok.level, DiagnosticStatus::OK);
+}
+
 TEST(MapperDiagnostics, BeforeStartTheSessionCountsAreShown) {
   MapperStatusSnapshot now;
   now.skipped_before_start = {{"no_extrinsic", 7}};

@@ -18,6 +18,7 @@ from irm_rostest import camera_info, drive, mask_image  # noqa: E402
 
 CYCLES = 5
 UNLOAD_LIMIT_S = 20.0  # a hang shows as a time-out far beyond this
+SHUTDOWN_BUDGET_S = 2.0  # ros/shutdown_budget_s of the instance that saves on unload
 
 
 class Feeder(threading.Thread):
@@ -62,13 +63,15 @@ class ReloadTest(unittest.TestCase):
         if os.path.exists(save_path):
             os.remove(save_path)
         unload_times = []
+        save_s = float("nan")
         try:
             for cycle in range(CYCLES):
                 name = "/mapper_r%d" % cycle
                 last = cycle == CYCLES - 1
                 params = irm.load_config(**{
                     "input/extrinsic": {"xyz": [1.0, 0.0, 1.5], "rpy_deg": [-95.0, 0.0, -90.0]},
-                    "ros/save_map_path": save_path if last else ""})
+                    "ros/save_map_path": save_path if last else "",
+                    "ros/shutdown_budget_s": SHUTDOWN_BUDGET_S})
                 self.assertTrue(manager.load(name, params), "load %s" % name)
                 self.assertIn(name, manager.loaded())
                 status = name.lstrip("/") + ": "
@@ -84,12 +87,18 @@ class ReloadTest(unittest.TestCase):
                 # Its services went with it.
                 irm.wait_for(lambda: name + "/save_map" not in irm.advertised_services(), 10,
                              "%s/save_map to be unadvertised" % name)
-            # The last instance saved its map on the way out. nodelet may destroy an unloaded
-            # instance only at the end of a callback in flight, after unload returned, and the
-            # save solves the last window first: wait for the file.
+            # The last instance saved its map on the way out, within its shutdown budget
+            # (+ 1 s) from the unload request, data still flowing. nodelet may destroy an
+            # unloaded instance only at the end of a callback in flight, after unload
+            # returned: wait for the file, and time it from the unload request.
             irm.wait_for(lambda: os.path.isfile(save_path), 60, "the map saved at shutdown")
+            save_s = time.monotonic() - start
+            self.assertLess(save_s, SHUTDOWN_BUDGET_S + 1.0)
+            self.assertLess(unload_times[-1], SHUTDOWN_BUDGET_S + 1.0)
             with open(save_path) as f:
-                self.assertGreater(len(json.load(f)["trajectory"]), 0)
+                saved = json.load(f)  # valid JSON (written atomically)
+            self.assertGreater(len(saved["trajectory"]), 0)
+            self.assertGreater(len(saved["lanes"]) + len(saved["markings"]), 0)
             # The manager is alive and takes the nodelet once more.
             self.assertTrue(manager.load("/mapper_again", params))
             rospy.wait_for_service("/mapper_again/save_map", timeout=30)
@@ -97,7 +106,8 @@ class ReloadTest(unittest.TestCase):
         finally:
             feeder.stop.set()
             feeder.join(5)
-        print("unload times (s): %s" % ", ".join("%.2f" % t for t in unload_times))
+        print("unload times (s): %s; the saving unload wrote its map after %.2f s" %
+              (", ".join("%.2f" % t for t in unload_times), save_s))
 
 
 if __name__ == "__main__":

@@ -32,6 +32,17 @@ class NodeletLoadTest(unittest.TestCase):
         # The manager survived the refused loads.
         self.assertIn("/mapper", self.list_loaded())
 
+    def test_refuses_a_synchronous_backend(self):
+        # Solves in the mapping thread would stall the input: refused at onInit, no mapping.
+        rospy.set_param("/sync_backend/backend/synchronous", True)
+        result = subprocess.run(
+            ["rosrun", "nodelet", "nodelet", "load", "ipm_road_mapper/MapperNodelet",
+             "manager", "--no-bond", "__name:=sync_backend"],
+            timeout=30, capture_output=True, text=True)
+        self.assertNotEqual(result.returncode, 0, result.stdout + result.stderr)
+        self.assertNotIn("/sync_backend", self.list_loaded())
+        self.assertIn("/mapper", self.list_loaded())
+
 
 if __name__ == "__main__":
     rospy.init_node("test_nodelet_load")

@@ -163,6 +163,39 @@ TEST(MarkerBuilder, VanishedElementsAreDeleted) {
       NamespacesOf(builder.Build(VectorMap(), "odom", ros::Time(6.0)), Marker::DELETE).empty());
 }
 
+TEST(MarkerBuilder, ChangesModeSendsOnlyWhatChanged) {
+  using Mode = MarkerBuilder::Mode;
+  MarkerBuilder builder;
+  VectorMap map = SomeMap();
+  EXPECT_EQ(builder.Build(map, "odom", ros::Time(1.0), Mode::kChanges).markers.size(), 4u);
+  // Nothing changed: nothing to send.
+  EXPECT_TRUE(builder.Build(map, "odom", ros::Time(2.0), Mode::kChanges).markers.empty());
+  // A moved marking and a new lane: just their markers, with stable ids.
+  map.markings[0].corners_map[0].x() += 0.2;
+  MapLane second = map.lanes[0];
+  second.id = 5;
+  map.lanes.push_back(second);
+  const auto changes = builder.Build(map, "odom", ros::Time(3.0), Mode::kChanges);
+  ASSERT_EQ(changes.markers.size(), 4u);
+  for (const Marker& m : changes.markers) {
+    EXPECT_EQ(m.action, Marker::ADD);
+    EXPECT_EQ(m.id, m.ns.rfind("mark", 0) == 0 ? 11 : 5) << m.ns;
+  }
+  // A lane's class changes (re-colored), the other lane leaves the map.
+  map.lanes[1].class_id = 7;
+  map.lanes.erase(map.lanes.begin());
+  const auto after = builder.Build(map, "odom", ros::Time(4.0), Mode::kChanges);
+  EXPECT_EQ(NamespacesOf(after, Marker::DELETE),
+            (std::set<std::string>{"lanes", "lane_control_points"}));
+  EXPECT_EQ(NamespacesOf(after, Marker::ADD),
+            (std::set<std::string>{"lanes", "lane_control_points"}));
+  for (const Marker& m : after.markers) EXPECT_EQ(m.id, m.action == Marker::DELETE ? 4 : 5);
+  // kFull re-sends every element, with no DELETE for what is still there.
+  const auto full = builder.Build(map, "odom", ros::Time(5.0), Mode::kFull);
+  EXPECT_EQ(full.markers.size(), 4u);
+  EXPECT_TRUE(NamespacesOf(full, Marker::DELETE).empty());
+}
+
 TEST(MarkerBuilder, ColorsAreStablePerClassAndDistinct) {
   const auto a = ClassColor(10, "arrow_straight");
   const auto b = ClassColor(11, "arrow_left");

@@ -193,11 +193,11 @@ else
 fi
 
 # 4. Sync: camera_info 2 ms off the masks. Exact pairs none; approximate pairs all.
-exact_config=$(overlay exact.yaml "input: {sync: exact}")
+exact_config=$(overlay exact.yaml "ros: {sync: exact}")
 run_mapper --bag "$work/shifted.bag" --config "$exact_config" --out "$work/exact" >/dev/null 2>&1 || fail "exact sync run"
 grep -q "^  no_camera_info: 25$" "$work/exact/summary.txt" && pass "exact sync skips shifted camera_info" \
   || fail "exact sync: $(grep -A3 skipped "$work/exact/summary.txt")"
-approx_config=$(overlay approx.yaml "input: {sync: approximate}")
+approx_config=$(overlay approx.yaml "ros: {sync: approximate}")
 run_mapper --bag "$work/shifted.bag" --config "$approx_config" --out "$work/approx" >/dev/null 2>&1 \
   || fail "approximate sync run"
 grep -q "^frames used: 25$" "$work/approx/summary.txt" && check_outputs "$work/approx" &&
@@ -219,9 +219,9 @@ expect_input_error "no --out" "usage" --bag "$work/drive.bag"
 expect_input_error "unknown flag" "unknown argument" --bag "$work/drive.bag" --out "$work/x" --fast
 bad_key=$(overlay bad_key.yaml "bogus_key: 1")
 expect_input_error "bad config key" "bogus_key: unknown key" --bag "$work/drive.bag" --config "$bad_key" --out "$work/x"
-bad_value=$(overlay bad_value.yaml "input: {sync: sometimes}")
-expect_input_error "bad config value" "input.sync" --bag "$work/drive.bag" --config "$bad_value" --out "$work/x"
-missing_topic=$(overlay missing_topic.yaml "input: {mask_topic: /nope}")
+bad_value=$(overlay bad_value.yaml "ros: {sync: sometimes}")
+expect_input_error "bad config value" "ros.sync" --bag "$work/drive.bag" --config "$bad_value" --out "$work/x"
+missing_topic=$(overlay missing_topic.yaml "ros: {mask_topic: /nope}")
 expect_input_error "missing topic" "/nope" --bag "$work/drive.bag" --config "$missing_topic" --out "$work/x"
 expect_input_error "no extrinsic" "no extrinsic" --bag "$work/no_tf.bag" --out "$work/x"
 echo "not a bag" >"$work/garbage.bag"

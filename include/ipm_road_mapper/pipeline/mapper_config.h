@@ -9,8 +9,8 @@
 #include <string>
 
 #include "ipm_road_mapper/core/io/geojson_export.h"
-#include "ipm_road_mapper/core/mapper/mapper_options.h"
 #include "ipm_road_mapper/core/io/yaml_options.h"
+#include "ipm_road_mapper/core/mapper/mapper_options.h"
 
 namespace ipm_road_mapper {
 
@@ -18,6 +18,11 @@ namespace ipm_road_mapper {
 // validates it too when a config holds it). Defaults are those of docs/ros_api.md and of
 // config/ros.yaml (a test checks that they agree).
 struct RosOptions {
+  std::string mask_topic = "/camera/instances";  // sensor_msgs/Image, 16UC1 masks
+  std::string camera_info_topic = "/camera/camera_info";
+  std::string image_topic = "/camera/image_raw";  // optional ("" = none), debug overlay only
+  std::string odom_topic = "/odom";               // nav_msgs/Odometry
+  std::string sync = "exact";                     // exact | approximate (mask <-> camera_info)
   double publish_rate_hz = 2.0;      // ~vector_map, ~markers, ~corrected_path, refined tf
   std::string map_frame;             // frame of the published map; "" = odometry header.frame_id
   std::string refined_camera_frame;  // tf child of the refined extrinsic; "" = <camera>_refined
@@ -34,6 +39,15 @@ struct RosOptions {
   // while someone subscribes).
   double debug_image_rate_hz = 5.0;
   double diagnostics_period_s = 1.0;
+  // Inputs (frames, odometry, debug images) waiting for the mapping thread; when full the
+  // oldest is dropped and counted.
+  int input_queue_size = 500;
+  // ~markers: the full marker set is re-sent this often (and to every new subscriber);
+  // in between only what changed.
+  double marker_full_period_s = 10.0;
+  // Unload / shutdown with save_map_path: the time the last solve may take before the
+  // latest snapshot is saved instead.
+  double shutdown_budget_s = 3.0;
 };
 
 // Everything a runner is configured with.
@@ -49,6 +63,10 @@ RosOptions LoadRosOptions(OptionsReader reader);
 // Reads a whole config (geo_origin, ros, then every core section; unknown keys are
 // errors). Throws OptionsError.
 MapperConfig LoadMapperConfig(OptionsReader reader);
+
+// Why the live nodelet cannot run this config ("" = it can): a synchronous back end would
+// solve in the mapping thread and stall the input.
+std::string CheckLiveConfig(const MapperConfig& config);
 
 // Loads a config file (a `base:` file is overlaid first); errors are prefixed with the path.
 MapperConfig LoadMapperConfigFile(const std::string& path);

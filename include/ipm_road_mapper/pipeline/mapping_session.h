@@ -4,11 +4,12 @@
 // Mapper, and every frame that cannot be used is counted by reason. The Mapper is created
 // when the rough extrinsic is known (Start); frames before that are counted as
 // `no_extrinsic` and the counts are handed to the Mapper when it starts. No ROS header, not
-// thread-safe: the nodelet holds its own mutex around every call.
+// thread-safe: the nodelet calls it from its mapping thread only (MappingWorker).
 #pragma once
 
 #include <Eigen/Geometry>
 #include <cstdint>
+#include <limits>
 #include <map>
 #include <memory>
 #include <optional>
@@ -16,9 +17,9 @@
 #include <vector>
 
 #include "ipm_road_mapper/core/frontend/class_table.h"
-#include "ipm_road_mapper/pipeline/frame_assembler.h"
 #include "ipm_road_mapper/core/mapper/mapper.h"
 #include "ipm_road_mapper/core/mapper/mapper_options.h"
+#include "ipm_road_mapper/pipeline/frame_assembler.h"
 
 namespace ipm_road_mapper {
 
@@ -53,8 +54,10 @@ class MappingSession {
   // Counts a frame the caller could not build (bad encoding, no camera_info, ...).
   void CountSkipped(const std::string& reason, SessionUpdate* update);
 
-  // End of input: decides every waiting frame, then Mapper::Finish (last window solved).
-  void Finish(SessionUpdate* update);
+  // End of input: decides every waiting frame, then Mapper::Finish(time_budget_s) (the last
+  // window solved, in at most about `time_budget_s` of wall time; infinity = no limit).
+  void Finish(SessionUpdate* update,
+              double time_budget_s = std::numeric_limits<double>::infinity());
 
   // Drops the map and every waiting frame and pose; options, extrinsic and counters stay.
   void Reset();

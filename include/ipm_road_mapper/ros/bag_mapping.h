@@ -11,7 +11,7 @@
 #include <functional>
 #include <optional>
 
-#include "ipm_road_mapper/core/mapper/input_options.h"
+#include "ipm_road_mapper/pipeline/mapper_config.h"
 #include "ipm_road_mapper/pipeline/mapping_session.h"
 
 namespace ipm_road_mapper {
@@ -26,10 +26,10 @@ struct BagMappingCallbacks {
   std::function<void()> first_frame_mapped;
 };
 
-// Maps the `input` topics of the open bag into the started session, then finishes it
+// Maps the `topics` (ros: section) of the open bag into the started session, then finishes it
 // (waiting frames decided, the last window solved). Returns the number of frames read.
 // Throws rosbag::BagException on a corrupt bag (after the messages before it).
-std::size_t MapBag(const rosbag::Bag& bag, const InputOptions& input, MappingSession* session,
+std::size_t MapBag(const rosbag::Bag& bag, const RosOptions& topics, MappingSession* session,
                    const BagMappingCallbacks& callbacks);
 
 }  // namespace ipm_road_mapper

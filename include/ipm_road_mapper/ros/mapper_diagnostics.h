@@ -22,8 +22,8 @@
 #include <string>
 
 #include "ipm_road_mapper/core/backend/backend.h"
-#include "ipm_road_mapper/pipeline/frame_assembler.h"
 #include "ipm_road_mapper/core/mapper/mapper.h"
+#include "ipm_road_mapper/pipeline/frame_assembler.h"
 
 namespace ipm_road_mapper {
 
@@ -50,7 +50,10 @@ struct MapperStatusSnapshot {
   Eigen::Isometry3d T_base_cam = Eigen::Isometry3d::Identity();
   std::uint64_t callbacks = 0;                                       // data callbacks timed
   double callback_mean_ms = 0.0, callback_max_ms = 0.0;              // every data callback
-  double frame_callback_mean_ms = 0.0, frame_callback_max_ms = 0.0;  // those that used frames
+  double frame_callback_mean_ms = 0.0, frame_callback_max_ms = 0.0;  // mask + camera_info ones
+  std::array<std::uint64_t, 3> inputs_dropped{};  // input queue full: frames, odometry, images
+  std::uint64_t publishes = 0;                    // map publications (timer cycles that sent)
+  double publish_cpu_last_ms = 0.0, publish_cpu_mean_ms = 0.0, publish_cpu_max_ms = 0.0;
 };
 
 // The four statuses (see the file comment). `previous` is the snapshot of the last update,

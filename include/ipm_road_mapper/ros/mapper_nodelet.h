@@ -1,15 +1,19 @@
 // The mapper as a nodelet (ipm_road_mapper/MapperNodelet; mapper_node wraps it). Wiring
-// only: parameters -> MapperConfig, subscriptions -> MappingSession (under one mutex),
+// only: parameters -> MapperConfig, subscriptions -> MappingWorker (the mapping thread),
 // a wall timer -> MapPublisher / diagnostics, services ~save_map and ~reset. Every topic,
 // parameter, service and frame is listed in docs/ros_api.md.
 //
-// Threading: data callbacks (masks + camera_info, odometry, the debug image) run on the
-// nodelet's single-threaded queue; the publish and diagnostics timers and the services on
-// `output_queue_`, a queue this object owns, served by its own spinner thread. `mutex_`
-// guards the session (Mapper + FrameAssembler, neither is thread-safe) and the state next
-// to it; ExportMap is the only map copy made under it, and nothing is published while it
-// is held. The Mapper's optimizer is its own thread: no callback waits for it (only the
-// shutdown save does, in Mapper::Finish).
+// Threading (docs/ros_api.md): data callbacks (masks + camera_info, odometry, the debug
+// image) run on the nodelet's single-threaded queue; they only convert the message to the
+// core's types and push it into the MappingWorker's bounded queue, never waiting on the
+// mapper, publishing, services or the optimizer. The MappingWorker's own thread runs the
+// session and swaps in immutable snapshots; the publish and diagnostics timers and the
+// services run on `output_queue_`, a queue this object owns, served by its own spinner
+// thread, and read the latest snapshot. ~reset is a command the mapping thread executes
+// (the service waits at most 2 s). The Mapper's optimizer is its own thread.
+// Unload: inputs, timers and services stop; with ros/save_map_path the mapping thread
+// finishes within ros/shutdown_budget_s and the best map available is saved; the mapping
+// thread is joined.
 // Why not the nodelet's multi-threaded queue: nodelet's queues hold the nodelet through a
 // weak_ptr locked per callback, so an unload during a data callback destroys the nodelet at
 // the end of that callback, in a worker thread, when its other queue may already be freed;
@@ -33,6 +37,7 @@
 #include <tf2_ros/buffer.h>
 #include <tf2_ros/transform_listener.h>
 
+#include <atomic>
 #include <chrono>
 #include <cstdint>
 #include <memory>
@@ -40,19 +45,20 @@
 #include <string>
 
 #include "ipm_road_mapper/SaveMap.h"
+#include "ipm_road_mapper/pipeline/mapper_config.h"
 #include "ipm_road_mapper/ros/debug_image_publisher.h"
 #include "ipm_road_mapper/ros/map_publisher.h"
-#include "ipm_road_mapper/pipeline/mapper_config.h"
 #include "ipm_road_mapper/ros/mapper_diagnostics.h"
-#include "ipm_road_mapper/pipeline/mapping_session.h"
+#include "ipm_road_mapper/ros/mapping_worker.h"
 
 namespace ipm_road_mapper {
 
 class MapperNodelet : public nodelet::Nodelet {
  public:
   MapperNodelet() = default;
-  // Stops every input, timer and service, saves the map when ros/save_map_path is set, then
-  // destroys the Mapper (its optimizer thread is joined).
+  // Stops every input, timer and service, saves the map when ros/save_map_path is set
+  // (within ros/shutdown_budget_s), joins the mapping thread and destroys the Mapper (its
+  // optimizer thread is joined).
   ~MapperNodelet() override;
 
  private:
@@ -66,47 +72,37 @@ class MapperNodelet : public nodelet::Nodelet {
   void SetUpInputs();
   void SetUpOutputs();
 
+  // Data callbacks: convert, push into the worker's queue, time themselves.
   void OnFrame(const sensor_msgs::ImageConstPtr& mask, const sensor_msgs::CameraInfoConstPtr& info);
   void OnOdometry(const nav_msgs::OdometryConstPtr& msg);
-  // Under mutex_: starts the session once the extrinsic is known (non-blocking tf lookup).
-  bool EnsureStartedLocked(const std::string& camera_frame);
-  // What a data callback takes out of the lock after a session call.
-  struct UpdateOutputs {
-    Eigen::Isometry3d T_map_base = Eigen::Isometry3d::Identity();  // newest used frame
-    Eigen::Isometry3d T_base_cam = Eigen::Isometry3d::Identity();
-    std::string map_frame, base_frame;
-    std::shared_ptr<const VectorMap> overlay_map;  // set when a debug overlay is due
-  };
-  // Under mutex_: notes a change and copies the newest used frame's pose and the extrinsic.
-  UpdateOutputs CollectLocked(const SessionUpdate& update);
-  // Outside mutex_: skip warnings, ~corrected_odom and the debug overlay of a used frame.
-  void AfterUpdate(const SessionUpdate& update, const UpdateOutputs& outputs);
-  // Wall time of one data callback; `used_frames`: frames it ran through the Mapper.
-  void RecordCallbackTime(std::chrono::steady_clock::time_point start, std::size_t used_frames);
+  void OnImage(const sensor_msgs::ImageConstPtr& image);
+  void RecordCallbackTime(std::chrono::steady_clock::time_point start, bool frame);
+  // In the mapping thread, after a used frame: ~corrected_odom and the debug overlay.
+  void AfterUpdate(const SessionUpdate& update, const FrameOutputs& outputs);
 
   void OnPublishTimer();
   bool OnSaveMap(ipm_road_mapper::SaveMap::Request& request,
                  ipm_road_mapper::SaveMap::Response& response);
   bool OnReset(std_srvs::Trigger::Request& request, std_srvs::Trigger::Response& response);
-  // The map as it is now, with the nodelet's metadata; empty optional before start.
-  std::optional<VectorMap> ExportLocked() const;
+  // The latest snapshot's status plus the callback, queue and publish figures.
   MapperStatusSnapshot Snapshot();
   void Shutdown();
+  // With ros/save_map_path: the mapping thread finishes until `deadline`, the best map
+  // available is saved, and the result logged.
+  void SaveAtShutdown(std::chrono::steady_clock::time_point deadline);
 
   MapperConfig config_;
   ClassTable classes_;
   std::string node_name_;
 
-  mutable std::mutex mutex_;  // guards everything down to the ROS handles
-  std::unique_ptr<MappingSession> session_;
-  std::string camera_frame_, refined_frame_, map_frame_, extrinsic_status_;
-  std::uint64_t changes_ = 0, published_changes_ = 0;
-  double last_frame_stamp_ = 0.0;
+  std::atomic<bool> shutting_down_{false};
+  std::mutex stats_mutex_;  // the callback and publish figures below
   std::uint64_t callbacks_ = 0, frame_callbacks_ = 0;
   double callback_total_ms_ = 0.0, callback_max_ms_ = 0.0;
   double frame_callback_total_ms_ = 0.0, frame_callback_max_ms_ = 0.0;
-  bool shutting_down_ = false;
-  std::chrono::steady_clock::time_point last_overlay_;
+  std::uint64_t publishes_ = 0;
+  double publish_cpu_last_ms_ = 0.0, publish_cpu_total_ms_ = 0.0, publish_cpu_max_ms_ = 0.0;
+  std::uint64_t published_version_ = 0;  // output thread only
 
   // Declared before every handle that uses it, so it is destroyed after them.
   ros::CallbackQueue output_queue_;
@@ -126,6 +122,8 @@ class MapperNodelet : public nodelet::Nodelet {
   std::unique_ptr<MapPublisher> map_publisher_;
   std::unique_ptr<DebugImagePublisher> debug_image_;
   std::unique_ptr<MapperDiagnostics> diagnostics_;
+  // Last: its thread calls into the publishers above, so it is stopped before they go.
+  std::unique_ptr<MappingWorker> worker_;
 };
 
 }  // namespace ipm_road_mapper

@@ -12,14 +12,7 @@ InputOptions LoadInputOptions(OptionsReader reader) {
   auto non_empty = [](const std::string& v) -> std::string {
     return v.empty() ? "must not be empty" : "";
   };
-  reader.Read<std::string>("mask_topic", &o.mask_topic, non_empty);
-  reader.Read<std::string>("camera_info_topic", &o.camera_info_topic, non_empty);
-  reader.Read<std::string>("image_topic", &o.image_topic);
-  reader.Read<std::string>("odom_topic", &o.odom_topic, non_empty);
   reader.Read<std::string>("base_frame", &o.base_frame, non_empty);
-  reader.Read<std::string>("sync", &o.sync, [](const std::string& v) -> std::string {
-    return v == "exact" || v == "approximate" ? "" : "must be exact or approximate";
-  });
   if (reader.Has("extrinsic")) {
     OptionsReader extrinsic = reader.Child("extrinsic");
     auto three_finite = [](const std::vector<double>& v) -> std::string {

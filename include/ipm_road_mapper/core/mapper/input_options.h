@@ -1,6 +1,7 @@
-// Where the mapper's input comes from (config section `input`): topic names, frames, the
-// sync policy and an optional extrinsic that overrides tf / the bag's /tf_static. Read by
-// both the offline runner and the nodelet, so the two agree.
+// What the core needs to know about its input (config section `input`): the vehicle frame
+// and an optional extrinsic that overrides tf / the bag's /tf_static. Read by both the
+// offline runner and the nodelet, so the two agree. Topic names and the mask/camera_info
+// sync policy are transport details: they live in the runners' `ros:` section (RosOptions).
 #pragma once
 
 #include <Eigen/Geometry>
@@ -12,12 +13,7 @@
 namespace ipm_road_mapper {
 
 struct InputOptions {
-  std::string mask_topic = "/camera/instances";
-  std::string camera_info_topic = "/camera/camera_info";
-  std::string image_topic = "/camera/image_raw";  // optional, debug overlay only
-  std::string odom_topic = "/odom";
   std::string base_frame = "base_link";
-  std::string sync = "exact";  // exact or approximate (mask <-> camera_info)
   // Rough extrinsic T_base_cam given in the config (xyz m, rpy deg of the optical frame in
   // base_link); when absent it comes from tf (/tf_static in a bag).
   std::optional<Eigen::Isometry3d> T_base_cam;

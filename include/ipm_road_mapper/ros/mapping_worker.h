@@ -1,0 +1,141 @@
+// The nodelet's mapping thread. It owns the MappingSession (FrameAssembler + core Mapper):
+// data callbacks Push() converted inputs into a bounded queue (the oldest dropped and
+// counted when full) and never wait for it; the thread pops them, runs the session, and at
+// most at ros/publish_rate_hz exports the map into an immutable MapSnapshot that it swaps
+// in under a mutex held only for the pointer swap. Publishing, diagnostics and ~save_map
+// read Latest(). ~reset and the shutdown Finish are commands the thread executes. Started
+// in the constructor, stopped by flag + notify + join (Stop, the destructor); never
+// detached. The core optimizer is the Mapper's own thread, joined by its destructor.
+#pragma once
+
+#include <Eigen/Geometry>
+#include <array>
+#include <atomic>
+#include <chrono>
+#include <condition_variable>
+#include <cstdint>
+#include <functional>
+#include <memory>
+#include <mutex>
+#include <string>
+#include <thread>
+
+#include "ipm_road_mapper/core/map/vector_map.h"
+#include "ipm_road_mapper/pipeline/bounded_input_queue.h"
+#include "ipm_road_mapper/pipeline/extrinsic_source.h"
+#include "ipm_road_mapper/pipeline/mapper_config.h"
+#include "ipm_road_mapper/pipeline/mapping_session.h"
+#include "ipm_road_mapper/ros/mapper_diagnostics.h"
+#include "ipm_road_mapper/ros/mapper_inputs.h"
+
+namespace ipm_road_mapper {
+
+// What the timers and services read; immutable once swapped in.
+struct MapSnapshot {
+  std::shared_ptr<const VectorMap> map;  // with the nodelet's metadata; nullptr before start
+  std::uint64_t map_version = 0;         // changes whenever the map may have changed
+  double newest_frame_stamp = 0.0;       // of the newest used frame (s)
+  std::string map_frame = "map";
+  std::string refined_camera_frame;  // tf child of the refined extrinsic ("" before start)
+  MapperStatusSnapshot status;       // the session's counters for the diagnostics
+};
+
+// What the mapping thread hands the nodelet after a frame was used.
+struct FrameOutputs {
+  Eigen::Isometry3d T_map_base = Eigen::Isometry3d::Identity();  // newest used frame
+  Eigen::Isometry3d T_base_cam = Eigen::Isometry3d::Identity();
+  std::string map_frame, base_frame;
+  std::shared_ptr<const VectorMap> overlay_map;  // set when a debug overlay is due
+};
+
+class MappingWorker {
+ public:
+  using Clock = std::chrono::steady_clock;
+  // Called in the mapping thread; must not block (publishing is fine).
+  struct Hooks {
+    std::function<void(const SessionUpdate&, const FrameOutputs&)> on_update;
+    std::function<void(const sensor_msgs::ImageConstPtr&)> on_image;  // ~debug_image input
+    std::function<bool()> overlay_wanted;                             // ~debug_image watched
+  };
+
+  // Starts the mapping thread. `lookup` is the non-blocking tf lookup of the extrinsic.
+  MappingWorker(const MapperConfig& config, const ClassTable& classes, std::string node_name,
+                TransformLookup lookup, Hooks hooks);
+  // Stop().
+  ~MappingWorker();
+
+  // From any data callback: queues the item; never waits for the mapping thread.
+  void Push(MapperInputItem item);
+
+  // The newest snapshot (never nullptr).
+  std::shared_ptr<const MapSnapshot> Latest() const;
+
+  // Items dropped because the queue was full, per InputKind.
+  std::array<std::uint64_t, kInputKindCount> dropped() const;
+
+  // Asks the mapping thread to reset the session and waits up to `timeout_s`; false (and
+  // *message says why) on a time-out, in which case a reset not yet begun is cancelled.
+  bool Reset(double timeout_s, std::string* message);
+
+  // No more pushes (later ones are ignored); a waiting Reset answers at once.
+  void CloseInputs();
+
+  // End of input: no more pushes; the thread maps what is queued, runs
+  // MappingSession::Finish with the time left until `deadline` and exports the map. Waits
+  // until then or `deadline`; returns the finished map (*finished = true) or else the
+  // latest snapshot's map; nullptr when the session never started.
+  std::shared_ptr<const VectorMap> Finish(Clock::time_point deadline, bool* finished);
+
+  // Stops and joins the mapping thread (idempotent); queued inputs are discarded.
+  void Stop();
+
+ private:
+  void Run();
+  void Handle(MapperInputItem& item);
+  void HandleFrame(FrameItem& frame);
+  void HandleOdometry(const OdometryItem& odometry);
+  bool EnsureStarted(const std::string& camera_frame);
+  void AfterUpdate(const SessionUpdate& update);
+  // Makes and swaps in a snapshot; re-exports the map only when it changed.
+  void Export();
+  // Runs the pending ~reset; true when the thread is to end (stop or finish done).
+  bool RunCommands();
+  void RunFinish(Clock::time_point deadline);
+  std::shared_ptr<VectorMap> ExportMap() const;
+  MapperStatusSnapshot Status() const;
+
+  const MapperConfig config_;
+  const std::string node_name_;
+  const TransformLookup lookup_;
+  const Hooks hooks_;
+  const Clock::duration export_period_, overlay_period_;
+
+  // Mapping thread only.
+  MappingSession session_;
+  std::string camera_frame_, extrinsic_status_, map_frame_;
+  std::string refined_frame_;
+  std::uint64_t map_version_ = 0, exported_version_ = 0;
+  bool status_dirty_ = true;
+  double newest_frame_stamp_ = 0.0;
+  std::shared_ptr<const VectorMap> exported_map_;
+  Clock::time_point next_export_, last_overlay_;
+
+  BoundedInputQueue<MapperInputItem> queue_;
+  std::array<std::atomic<std::uint64_t>, kInputKindCount> dropped_{};
+
+  mutable std::mutex snapshot_mutex_;  // held only to swap / copy the pointer
+  std::shared_ptr<const MapSnapshot> latest_;
+
+  std::mutex command_mutex_;  // the commands below
+  std::condition_variable command_done_;
+  bool stop_ = false, inputs_closed_ = false;
+  bool reset_requested_ = false, reset_running_ = false;
+  std::uint64_t resets_done_ = 0;
+  bool finish_requested_ = false, finish_done_ = false;
+  Clock::time_point finish_deadline_;
+  std::shared_ptr<const VectorMap> finished_map_;
+
+  std::thread thread_;  // last: started after everything above exists
+};
+
+}  // namespace ipm_road_mapper

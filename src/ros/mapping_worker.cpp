@@ -1,0 +1,307 @@
+#include "ipm_road_mapper/ros/mapping_worker.h"
+
+#include <ros/console.h>
+
+#include <algorithm>
+#include <utility>
+
+namespace ipm_road_mapper {
+namespace {
+
+using Seconds = std::chrono::duration<double>;
+
+MappingWorker::Clock::duration Period(double rate_hz) {
+  return std::chrono::duration_cast<MappingWorker::Clock::duration>(Seconds(1.0 / rate_hz));
+}
+
+}  // namespace
+
+MappingWorker::MappingWorker(const MapperConfig& config, const ClassTable& classes,
+                             std::string node_name, TransformLookup lookup, Hooks hooks)
+    : config_(config),
+      node_name_(std::move(node_name)),
+      lookup_(std::move(lookup)),
+      hooks_(std::move(hooks)),
+      export_period_(Period(config.ros.publish_rate_hz)),
+      overlay_period_(Period(config.ros.debug_image_rate_hz)),
+      session_(config.mapper, classes, config.ros.odometry_wait_s),
+      queue_(static_cast<std::size_t>(config.ros.input_queue_size)),
+      latest_(std::make_shared<const MapSnapshot>()) {
+  next_export_ = Clock::now();
+  thread_ = std::thread([this] { Run(); });
+}
+
+MappingWorker::~MappingWorker() { Stop(); }
+
+void MappingWorker::Push(MapperInputItem item) {
+  const std::optional<MapperInputItem> dropped = queue_.Push(std::move(item));
+  if (!dropped) return;
+  const InputKind kind = KindOf(*dropped);
+  ++dropped_[static_cast<std::size_t>(kind)];
+  ROS_WARN_THROTTLE(5.0,
+                    "%s: the mapping thread falls behind: input queue full (%zu), oldest %s "
+                    "dropped (counted on /diagnostics)",
+                    node_name_.c_str(), queue_.capacity(), InputKindName(kind));
+}
+
+std::shared_ptr<const MapSnapshot> MappingWorker::Latest() const {
+  std::lock_guard<std::mutex> lock(snapshot_mutex_);
+  return latest_;
+}
+
+std::array<std::uint64_t, kInputKindCount> MappingWorker::dropped() const {
+  std::array<std::uint64_t, kInputKindCount> out{};
+  for (std::size_t i = 0; i < kInputKindCount; ++i) out[i] = dropped_[i].load();
+  return out;
+}
+
+bool MappingWorker::Reset(double timeout_s, std::string* message) {
+  std::unique_lock<std::mutex> lock(command_mutex_);
+  const std::uint64_t target = resets_done_ + 1;
+  reset_requested_ = true;
+  queue_.Wake();
+  const bool done = command_done_.wait_for(lock, Seconds(timeout_s), [&] {
+    return resets_done_ >= target || stop_ || inputs_closed_ || finish_requested_;
+  });
+  if (done && resets_done_ >= target) {
+    *message = "map, waiting frames and odometry cleared";
+    return true;
+  }
+  if (reset_requested_ && !reset_running_) {
+    reset_requested_ = false;  // not begun: cancelled, the map stays as it is
+    *message = done ? "not reset: the nodelet is shutting down"
+                    : "not reset: the mapping thread did not take the command within " +
+                          std::to_string(timeout_s) + " s";
+  } else {
+    *message = "the reset is still running after " + std::to_string(timeout_s) + " s";
+  }
+  return false;
+}
+
+void MappingWorker::CloseInputs() {
+  queue_.Close();
+  {
+    std::lock_guard<std::mutex> lock(command_mutex_);
+    inputs_closed_ = true;
+  }
+  command_done_.notify_all();
+}
+
+std::shared_ptr<const VectorMap> MappingWorker::Finish(Clock::time_point deadline, bool* finished) {
+  queue_.Close();  // no more inputs; what is queued is still mapped
+  std::unique_lock<std::mutex> lock(command_mutex_);
+  finish_requested_ = true;
+  finish_deadline_ = deadline;
+  queue_.Wake();
+  *finished = command_done_.wait_until(lock, deadline, [this] { return finish_done_; });
+  if (*finished) return finished_map_;
+  lock.unlock();
+  return Latest()->map;
+}
+
+void MappingWorker::Stop() {
+  {
+    std::lock_guard<std::mutex> lock(command_mutex_);
+    stop_ = true;
+  }
+  queue_.Close();
+  queue_.Wake();
+  command_done_.notify_all();
+  if (thread_.joinable()) thread_.join();
+}
+
+void MappingWorker::Run() {
+  while (!RunCommands()) {
+    MapperInputItem item;
+    if (queue_.PopUntil(next_export_, &item)) Handle(item);
+    if (Clock::now() >= next_export_) {
+      if (status_dirty_ || map_version_ != exported_version_) Export();
+      next_export_ = Clock::now() + export_period_;
+    }
+  }
+}
+
+bool MappingWorker::RunCommands() {
+  bool reset = false, finish = false;
+  Clock::time_point deadline;
+  {
+    std::lock_guard<std::mutex> lock(command_mutex_);
+    if (stop_) return true;
+    if (finish_done_) return true;
+    reset = reset_requested_;
+    if (reset) reset_running_ = true;
+    reset_requested_ = false;
+    finish = finish_requested_;
+    deadline = finish_deadline_;
+  }
+  if (reset) {
+    session_.Reset();
+    ++map_version_;
+    Export();  // the services and timers see the empty map at once
+    {
+      std::lock_guard<std::mutex> lock(command_mutex_);
+      reset_running_ = false;
+      ++resets_done_;
+    }
+    command_done_.notify_all();
+    ROS_INFO("%s: reset: map, waiting frames and odometry cleared", node_name_.c_str());
+  }
+  if (!finish) return false;
+  RunFinish(deadline);
+  return true;
+}
+
+void MappingWorker::RunFinish(Clock::time_point deadline) {
+  MapperInputItem item;
+  while (Clock::now() < deadline && queue_.PopUntil(Clock::now(), &item)) Handle(item);
+  std::shared_ptr<const VectorMap> map;
+  if (session_.started()) {
+    const double budget_s = std::max(0.0, Seconds(deadline - Clock::now()).count());
+    SessionUpdate update;
+    session_.Finish(&update, budget_s);  // waiting frames decided, the last window solved
+    ++map_version_;
+    Export();
+    map = exported_map_;
+  }
+  {
+    std::lock_guard<std::mutex> lock(command_mutex_);
+    finished_map_ = std::move(map);
+    finish_done_ = true;
+  }
+  command_done_.notify_all();
+}
+
+void MappingWorker::Handle(MapperInputItem& item) {
+  status_dirty_ = true;
+  if (auto* frame = std::get_if<FrameItem>(&item)) {
+    HandleFrame(*frame);
+  } else if (auto* odometry = std::get_if<OdometryItem>(&item)) {
+    HandleOdometry(*odometry);
+  } else if (auto* image = std::get_if<ImageItem>(&item)) {
+    if (hooks_.on_image) hooks_.on_image(image->image);
+  }
+}
+
+void MappingWorker::HandleFrame(FrameItem& frame) {
+  SessionUpdate update;
+  if (!frame.error.empty()) {
+    session_.CountSkipped(frame.error, &update);
+  } else if (!EnsureStarted(frame.camera_frame)) {
+    session_.CountSkipped("no_extrinsic: " + extrinsic_status_, &update);
+  } else {
+    session_.AddFrame(frame.stamp, std::move(frame.mask), frame.camera, &update);
+  }
+  AfterUpdate(update);
+}
+
+void MappingWorker::HandleOdometry(const OdometryItem& odometry) {
+  if (map_frame_.empty()) {
+    map_frame_ = !config_.ros.map_frame.empty() ? config_.ros.map_frame
+                 : !odometry.frame_id.empty()   ? odometry.frame_id
+                                                : std::string("map");
+  }
+  SessionUpdate update;
+  session_.AddOdometry(odometry.pose, &update);
+  AfterUpdate(update);
+}
+
+bool MappingWorker::EnsureStarted(const std::string& camera_frame) {
+  if (session_.started()) return true;
+  ExtrinsicChoice choice;
+  const std::string error =
+      ChooseExtrinsic(config_.mapper.input, camera_frame, lookup_, "tf", &choice);
+  if (!error.empty()) {
+    extrinsic_status_ = error;
+    ROS_WARN_THROTTLE(5.0, "%s: %s (frames are skipped until it is known)", node_name_.c_str(),
+                      error.c_str());
+    return false;
+  }
+  camera_frame_ = camera_frame.empty() ? std::string("camera") : camera_frame;
+  refined_frame_ = config_.ros.refined_camera_frame.empty() ? camera_frame_ + "_refined"
+                                                            : config_.ros.refined_camera_frame;
+  if (refined_frame_ == camera_frame_) {
+    ROS_ERROR(
+        "%s: ros/refined_camera_frame is the camera frame %s: publishing it would give that "
+        "frame a second parent; using %s_refined instead",
+        node_name_.c_str(), camera_frame_.c_str(), camera_frame_.c_str());
+    refined_frame_ = camera_frame_ + "_refined";
+  }
+  session_.Start(choice.T_base_cam);
+  extrinsic_status_ = choice.source;
+  ++map_version_;
+  ROS_INFO("%s: rough extrinsic from %s; refined extrinsic published as %s -> %s",
+           node_name_.c_str(), choice.source.c_str(), config_.mapper.input.base_frame.c_str(),
+           refined_frame_.c_str());
+  return true;
+}
+
+void MappingWorker::AfterUpdate(const SessionUpdate& update) {
+  for (const std::string& reason : update.skipped) {
+    ROS_WARN_THROTTLE(5.0, "%s: frame skipped: %s", node_name_.c_str(), reason.c_str());
+  }
+  if (update.used.empty()) return;
+  ++map_version_;
+  newest_frame_stamp_ = update.used.back().stamp;
+  const Mapper& mapper = *session_.mapper();
+  FrameOutputs outputs;
+  outputs.T_map_base = mapper.map().frames.back().T_map_base;
+  outputs.T_base_cam = mapper.T_base_cam();
+  outputs.map_frame = map_frame_.empty() ? "map" : map_frame_;
+  outputs.base_frame = config_.mapper.input.base_frame;
+  // The overlay draws the map as of its frame: a fresh snapshot, throttled, only when watched.
+  const Clock::time_point now = Clock::now();
+  if (hooks_.overlay_wanted && hooks_.overlay_wanted() && now - last_overlay_ >= overlay_period_) {
+    last_overlay_ = now;
+    Export();
+    outputs.overlay_map = exported_map_;
+  }
+  if (hooks_.on_update) hooks_.on_update(update, outputs);
+}
+
+std::shared_ptr<VectorMap> MappingWorker::ExportMap() const {
+  auto map = std::make_shared<VectorMap>(session_.mapper()->ExportMap());
+  map->frame_id = map_frame_.empty() ? "map" : map_frame_;
+  map->metadata["source"] = "ipm_road_mapper/MapperNodelet " + node_name_;
+  map->metadata["extrinsic_source"] = extrinsic_status_;
+  return map;
+}
+
+MapperStatusSnapshot MappingWorker::Status() const {
+  MapperStatusSnapshot s;
+  s.started = session_.started();
+  s.extrinsic_status = extrinsic_status_.empty() ? "no frame yet" : extrinsic_status_;
+  s.skipped_before_start = session_.skipped_before_start();
+  s.assembler = session_.assembler().counters();
+  if (const Mapper* mapper = session_.mapper()) {
+    s.counters = mapper->counters();
+    s.backend_enabled = mapper->options().backend.enabled;
+    s.backend = mapper->backend_stats();
+    s.T_base_cam_initial = mapper->T_base_cam_initial();
+    s.T_base_cam = mapper->T_base_cam();
+  }
+  return s;
+}
+
+void MappingWorker::Export() {
+  if (session_.started() && (map_version_ != exported_version_ || !exported_map_)) {
+    exported_map_ = ExportMap();
+  }
+  exported_version_ = map_version_;
+  status_dirty_ = false;
+  auto snapshot = std::make_shared<MapSnapshot>();
+  snapshot->map = exported_map_;
+  snapshot->map_version = map_version_;
+  snapshot->newest_frame_stamp = newest_frame_stamp_;
+  snapshot->map_frame = map_frame_.empty() ? "map" : map_frame_;
+  snapshot->refined_camera_frame = refined_frame_;
+  snapshot->status = Status();
+  std::shared_ptr<const MapSnapshot> old;
+  {
+    std::lock_guard<std::mutex> lock(snapshot_mutex_);
+    old = std::move(latest_);
+    latest_ = std::move(snapshot);
+  }
+  // `old` (and its map, if no reader holds it) is freed here, outside the lock.
+}
+
+}  // namespace ipm_road_mapper

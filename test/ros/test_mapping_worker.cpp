@@ -1,0 +1,180 @@
+// The nodelet's mapping thread: inputs pushed from "callbacks" are mapped in its own thread
+// and show up in the snapshots; a full queue drops the oldest and counts it by kind while
+// the pusher never waits; ~reset runs as a command (and times out when the thread is
+// busy); Finish returns the finished map within its deadline; Stop joins promptly.
+#include <gtest/gtest.h>
+
+#include <chrono>
+#include <condition_variable>
+#include <functional>
+#include <mutex>
+#include <thread>
+
+#include "ipm_road_mapper/ros/mapping_worker.h"
+
+namespace ipm_road_mapper {
+namespace {
+
+using Clock = std::chrono::steady_clock;
+
+MapperConfig Config(int queue_size = 100) {
+  MapperConfig config;
+  config.mapper.backend.enabled = false;
+  Eigen::Matrix3d R;
+  R << 0, 0, 1, -1, 0, 0, 0, -1, 0;
+  Eigen::Isometry3d T = Eigen::Isometry3d::Identity();
+  T.linear() = R;
+  T.translation() = Eigen::Vector3d(1.5, 0.0, 1.5);
+  config.mapper.input.T_base_cam = T;  // no tf needed
+  config.ros.publish_rate_hz = 50.0;
+  config.ros.input_queue_size = queue_size;
+  return config;
+}
+
+ClassTable Classes() {
+  return ClassTable::Load(
+      OptionsReader(YAML::Load("classes:\n  - {id: 10, name: arrow, kind: marking}\n"), ""));
+}
+
+FrameItem Frame(double stamp) {
+  FrameItem frame;
+  frame.stamp = stamp;
+  frame.camera.width = 640;
+  frame.camera.height = 480;
+  frame.camera.fx = frame.camera.fy = 500.0;
+  frame.camera.cx = 320.0;
+  frame.camera.cy = 240.0;
+  frame.mask = cv::Mat(480, 640, CV_16UC1, cv::Scalar(0));
+  frame.camera_frame = "camera";
+  return frame;
+}
+
+OdometryItem Odometry(double stamp) {
+  OdometryItem odometry;
+  odometry.pose.stamp = stamp;
+  odometry.pose.T_map_base.translation() = Eigen::Vector3d(10.0 * stamp, 0.0, 0.0);
+  odometry.frame_id = "odom";
+  return odometry;
+}
+
+const TransformLookup kNoTf = [](const std::string&, const std::string&, Eigen::Isometry3d*) {
+  return std::string("no tf in this test");
+};
+
+// Waits (bounded) until the latest snapshot satisfies `condition`.
+template <typename Condition>
+bool WaitForSnapshot(const MappingWorker& worker, Condition condition) {
+  const auto deadline = Clock::now() + std::chrono::seconds(10);
+  while (Clock::now() < deadline) {
+    if (condition(*worker.Latest())) return true;
+    std::this_thread::sleep_for(std::chrono::milliseconds(5));
+  }
+  return false;
+}
+
+void Feed(MappingWorker* worker, int frames) {
+  for (int i = 0; i <= frames; ++i) {
+    worker->Push(Odometry(0.1 * i));
+    if (i < frames) worker->Push(Frame(0.1 * i + 0.05));
+  }
+}
+
+TEST(MappingWorker, MapsInItsThreadAndPublishesSnapshots) {
+  std::atomic<int> updates{0};
+  MappingWorker::Hooks hooks;
+  hooks.on_update = [&](const SessionUpdate& update, const FrameOutputs& outputs) {
+    updates += static_cast<int>(update.used.size());
+    EXPECT_EQ(outputs.map_frame, "odom");
+  };
+  MappingWorker worker(Config(), Classes(), "test", kNoTf, hooks);
+  EXPECT_EQ(worker.Latest()->map, nullptr);  // before the first frame
+  Feed(&worker, 10);
+  ASSERT_TRUE(WaitForSnapshot(
+      worker, [](const MapSnapshot& s) { return s.map && s.status.counters.frames_used == 10; }));
+  const auto snapshot = worker.Latest();
+  EXPECT_EQ(snapshot->map->frame_id, "odom");
+  EXPECT_EQ(snapshot->map->trajectory.size(), 10u);
+  EXPECT_EQ(snapshot->refined_camera_frame, "camera_refined");
+  EXPECT_NEAR(snapshot->newest_frame_stamp, 0.95, 1e-9);
+  EXPECT_EQ(updates.load(), 10);
+  EXPECT_EQ(worker.dropped(), (std::array<std::uint64_t, kInputKindCount>{}));
+}
+
+TEST(MappingWorker, FullQueueDropsTheOldestWithoutBlockingThePusher) {
+  ros::Time::init();  // the throttled drop warning reads ROS time (no node in this test)
+  std::mutex mutex;
+  std::condition_variable released;
+  bool release = false, blocked = false;
+  MappingWorker::Hooks hooks;
+  hooks.on_update = [&](const SessionUpdate&, const FrameOutputs&) {
+    std::unique_lock<std::mutex> lock(mutex);
+    blocked = true;
+    released.notify_all();
+    released.wait(lock, [&] { return release; });  // the mapping thread is busy
+  };
+  MappingWorker worker(Config(5), Classes(), "test", kNoTf, hooks);
+  // Destroyed before the worker: whatever fails below, the hook is released and joined.
+  struct Release {
+    std::function<void()> fn;
+    ~Release() { fn(); }
+  } release_at_exit{[&] {
+    {
+      std::lock_guard<std::mutex> lock(mutex);
+      release = true;
+    }
+    released.notify_all();
+  }};
+  Feed(&worker, 1);  // one used frame: the thread blocks in its hook
+  {
+    std::unique_lock<std::mutex> lock(mutex);
+    ASSERT_TRUE(released.wait_for(lock, std::chrono::seconds(10), [&] { return blocked; }));
+  }
+  const auto start = Clock::now();
+  for (int i = 0; i < 20; ++i) worker.Push(Odometry(1.0 + 0.1 * i));
+  EXPECT_LT(Clock::now() - start, std::chrono::seconds(1));  // never waited for the mapper
+  EXPECT_EQ(worker.dropped()[static_cast<std::size_t>(InputKind::kOdometry)], 15u);
+  EXPECT_EQ(worker.dropped()[static_cast<std::size_t>(InputKind::kFrame)], 0u);
+  // A reset cannot run while the thread is busy: the service answers failure in time.
+  std::string message;
+  const auto reset_start = Clock::now();
+  EXPECT_FALSE(worker.Reset(0.2, &message));
+  EXPECT_LT(Clock::now() - reset_start, std::chrono::seconds(2));
+  EXPECT_NE(message.find("not reset"), std::string::npos) << message;
+}
+
+TEST(MappingWorker, ResetIsACommandOfTheMappingThread) {
+  MappingWorker worker(Config(), Classes(), "test", kNoTf, {});
+  Feed(&worker, 5);
+  ASSERT_TRUE(WaitForSnapshot(
+      worker, [](const MapSnapshot& s) { return s.map && s.map->trajectory.size() == 5; }));
+  std::string message;
+  EXPECT_TRUE(worker.Reset(2.0, &message)) << message;
+  const auto after = worker.Latest();  // swapped in before Reset returned
+  ASSERT_NE(after->map, nullptr);
+  EXPECT_TRUE(after->map->trajectory.empty());
+}
+
+TEST(MappingWorker, FinishReturnsTheFinishedMapAndStopJoins) {
+  MappingWorker worker(Config(), Classes(), "test", kNoTf, {});
+  Feed(&worker, 8);
+  bool finished = false;
+  const auto start = Clock::now();
+  const auto map = worker.Finish(start + std::chrono::seconds(3), &finished);
+  EXPECT_TRUE(finished);
+  ASSERT_NE(map, nullptr);
+  EXPECT_EQ(map->trajectory.size(), 8u);  // what was queued was mapped first
+  worker.Push(Odometry(9.0));             // after Finish: ignored
+  worker.Stop();
+  EXPECT_LT(Clock::now() - start, std::chrono::seconds(3 + 1));
+  worker.Stop();  // idempotent
+}
+
+TEST(MappingWorker, FinishBeforeAnyFrameHasNoMap) {
+  MappingWorker worker(Config(), Classes(), "test", kNoTf, {});
+  bool finished = false;
+  EXPECT_EQ(worker.Finish(Clock::now() + std::chrono::seconds(2), &finished), nullptr);
+  EXPECT_TRUE(finished);
+}
+
+}  // namespace
+}  // namespace ipm_road_mapper
