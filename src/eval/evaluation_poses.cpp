@@ -2,8 +2,8 @@
 #include <algorithm>
 #include <cmath>
 
-#include "ipm_road_mapper/eval/evaluation.h"
 #include "ipm_road_mapper/core/geometry/ipm.h"
+#include "ipm_road_mapper/eval/evaluation.h"
 
 namespace ipm_road_mapper {
 namespace {

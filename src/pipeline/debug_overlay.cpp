@@ -9,8 +9,8 @@
 #include <opencv2/imgproc.hpp>
 #include <vector>
 
-#include "ipm_road_mapper/core/geometry/catmull_rom_spline.h"
 #include "ipm_road_mapper/core/frontend/instance_extraction.h"
+#include "ipm_road_mapper/core/geometry/catmull_rom_spline.h"
 #include "ipm_road_mapper/core/geometry/ipm.h"
 #include "ipm_road_mapper/core/geometry/rigid_transform.h"
 

@@ -34,8 +34,7 @@ YAML::Node XmlRpcToYaml(const XmlRpc::XmlRpcValue& value) {
 YAML::Node ParamsToYaml(const ros::NodeHandle& nh, const std::vector<std::string>& ros_only_keys) {
   XmlRpc::XmlRpcValue all;
   YAML::Node root(YAML::NodeType::Map);
-  if (!nh.getParam(nh.getNamespace(), all) ||
-      all.getType() != XmlRpc::XmlRpcValue::TypeStruct) {
+  if (!nh.getParam(nh.getNamespace(), all) || all.getType() != XmlRpc::XmlRpcValue::TypeStruct) {
     return root;
   }
   for (auto it = all.begin(); it != all.end(); ++it) {

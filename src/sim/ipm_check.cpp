@@ -1,8 +1,9 @@
+#include "ipm_road_mapper/sim/ipm_check.h"
+
 #include <cmath>
 #include <limits>
 
 #include "ipm_road_mapper/core/geometry/ipm.h"
-#include "ipm_road_mapper/sim/ipm_check.h"
 
 namespace ipm_road_mapper {
 namespace sim {

@@ -1,8 +1,8 @@
+#include "ipm_road_mapper/sim/renderer.h"
+
 #include <algorithm>
 #include <cmath>
 #include <opencv2/imgproc.hpp>
-
-#include "ipm_road_mapper/sim/renderer.h"
 
 namespace ipm_road_mapper {
 namespace sim {

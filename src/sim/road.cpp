@@ -1,7 +1,7 @@
+#include "ipm_road_mapper/sim/road.h"
+
 #include <algorithm>
 #include <cmath>
-
-#include "ipm_road_mapper/sim/road.h"
 
 namespace ipm_road_mapper {
 namespace sim {

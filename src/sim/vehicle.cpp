@@ -1,8 +1,9 @@
+#include "ipm_road_mapper/sim/vehicle.h"
+
 #include <cmath>
 
 #include "ipm_road_mapper/core/geometry/rigid_transform.h"
 #include "ipm_road_mapper/sim/sim_random.h"
-#include "ipm_road_mapper/sim/vehicle.h"
 
 namespace ipm_road_mapper {
 namespace sim {

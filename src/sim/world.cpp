@@ -1,7 +1,7 @@
+#include "ipm_road_mapper/sim/world.h"
+
 #include <algorithm>
 #include <cmath>
-
-#include "ipm_road_mapper/sim/world.h"
 
 namespace ipm_road_mapper {
 namespace sim {

@@ -44,7 +44,7 @@ classes:
 
 // Fills the ground polygon (map frame, z = 0) seen from T_map_base into the mask.
 inline void FillGround(const std::vector<Eigen::Vector3d>& polygon_map,
-                const Eigen::Isometry3d& T_map_base, int value, cv::Mat* mask) {
+                       const Eigen::Isometry3d& T_map_base, int value, cv::Mat* mask) {
   const Ipm ipm(PinholeCamera(TestCamera()), TestExtrinsic(), 100.0);
   std::vector<cv::Point> pixels;
   for (std::size_t i = 0; i < polygon_map.size(); ++i) {

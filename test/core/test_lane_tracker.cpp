@@ -18,8 +18,8 @@ struct Rig {
   }
   void Step(const FrameInput& in) {
     const Ipm ipm(PinholeCamera(in.camera), TestExtrinsic(), options.ipm.max_range_m);
-    FrameObservations obs = ExtractObservations(in.mask, classes, ipm, options.ipm.error_model,
-                                                options.extraction);
+    FrameObservations obs =
+        ExtractObservations(in.mask, classes, ipm, options.ipm.error_model, options.extraction);
     const FrameRecord& frame = store.AddFrame(in.stamp, in.T_map_base_odom);
     tracker.Update(obs.lanes, frame);
     tracker.DropSpurious(frame.index);

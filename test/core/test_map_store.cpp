@@ -54,7 +54,8 @@ TEST(MapStore, RoadDirectionIsTheNearestLanesTangent) {
   LaneElement along_x;
   for (int i = -1; i <= 10; ++i) along_x.control_points_map.emplace_back(3.0 * i, 2.0, 0.0);
   LaneElement diagonal;
-  for (int i = -1; i <= 10; ++i) diagonal.control_points_map.emplace_back(3.0 * i, 3.0 * i - 9.0, 0.0);
+  for (int i = -1; i <= 10; ++i)
+    diagonal.control_points_map.emplace_back(3.0 * i, 3.0 * i - 9.0, 0.0);
   store.lanes().push_back(along_x);
   store.lanes().push_back(diagonal);
   const Eigen::Vector3d near_x = store.RoadDirectionAt(Eigen::Vector3d(10.0, 2.5, 0.0));

@@ -5,8 +5,8 @@
 
 #include <opencv2/imgproc.hpp>
 
-#include "ipm_road_mapper/core/geometry/ipm.h"
 #include "common/road_scene.h"
+#include "ipm_road_mapper/core/geometry/ipm.h"
 #include "ipm_road_mapper/core/mapper/mapper.h"
 
 namespace ipm_road_mapper {

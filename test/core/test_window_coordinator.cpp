@@ -35,8 +35,8 @@ struct Rig {
   bool Step(const FrameInput& in) {
     windows.ApplyResults();
     const Ipm ipm(PinholeCamera(in.camera), windows.T_base_cam(), options.ipm.max_range_m);
-    FrameObservations obs = ExtractObservations(in.mask, classes, ipm, options.ipm.error_model,
-                                                options.extraction);
+    FrameObservations obs =
+        ExtractObservations(in.mask, classes, ipm, options.ipm.error_model, options.extraction);
     const FrameRecord& frame = store.AddFrame(in.stamp, in.T_map_base_odom);
     markings.Update(ipm, frame, &obs.markings);
     lanes.Update(obs.lanes, frame);

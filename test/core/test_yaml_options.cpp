@@ -327,8 +327,8 @@ TEST(MapperOptions, FileErrorsNameTheFileAndTheKey) {
   EXPECT_EQ(FileError("type_list", "backend: {translation_prior_sigma_m: {x: 1}}\n"),
             "backend.translation_prior_sigma_m: wrong type: expected a sequence of numbers, "
             "got a map");
-  EXPECT_EQ(FileError("type_string", "input: {sync: [exact]}\n"),
-            "input.sync: wrong type: expected a string, got a sequence");
+  EXPECT_EQ(FileError("type_string", "input: {base_frame: [base_link]}\n"),
+            "input.base_frame: wrong type: expected a string, got a sequence");
   EXPECT_EQ(FileError("chord", "lanes: {chord_spacing_m: 1e-4}\n"),
             "lanes.chord_spacing_m: must be >= 0.5 m (got 0.0001)");
 }

@@ -13,10 +13,10 @@
 #include <opencv2/core.hpp>
 
 #include "ipm_road_mapper/core/frontend/class_table.h"
-#include "ipm_road_mapper/core/mapper/mapper_options.h"
 #include "ipm_road_mapper/core/frontend/observations.h"
 #include "ipm_road_mapper/core/geometry/pinhole_camera.h"
 #include "ipm_road_mapper/core/map/vector_map.h"
+#include "ipm_road_mapper/core/mapper/mapper_options.h"
 
 namespace ipm_road_mapper {
 

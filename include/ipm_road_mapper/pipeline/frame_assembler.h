@@ -29,10 +29,10 @@
 #include <string>
 #include <vector>
 
-#include "ipm_road_mapper/core/mapper/mapper.h"
-#include "ipm_road_mapper/core/mapper/mapper_options.h"
 #include "ipm_road_mapper/core/geometry/pinhole_camera.h"
 #include "ipm_road_mapper/core/geometry/rigid_transform.h"
+#include "ipm_road_mapper/core/mapper/mapper.h"
+#include "ipm_road_mapper/core/mapper/mapper_options.h"
 
 namespace ipm_road_mapper {
 

@@ -9,8 +9,8 @@
 #include <vector>
 
 #include "ipm_road_mapper/core/frontend/class_table.h"
-#include "ipm_road_mapper/core/io/ground_truth.h"
 #include "ipm_road_mapper/core/geometry/pinhole_camera.h"
+#include "ipm_road_mapper/core/io/ground_truth.h"
 #include "ipm_road_mapper/sim/renderer.h"
 #include "ipm_road_mapper/sim/scenario.h"
 #include "ipm_road_mapper/sim/vehicle.h"

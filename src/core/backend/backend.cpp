@@ -2,7 +2,6 @@
 
 #include <algorithm>
 #include <chrono>
-
 #include <utility>
 
 #include "ipm_road_mapper/core/mapper/timing_series.h"

@@ -80,8 +80,7 @@ void FrameIndex::ForRing(std::int64_t ix, std::int64_t iy, std::int64_t ring, F 
   }
 }
 
-std::vector<std::size_t> FrameIndex::Within(const Eigen::Vector3d& p_map,
-                                            double radius_m) const {
+std::vector<std::size_t> FrameIndex::Within(const Eigen::Vector3d& p_map, double radius_m) const {
   std::vector<std::size_t> out;
   if (positions_.empty() || !(radius_m >= 0.0)) return out;
   const std::int64_t x0 = std::max(Cell(p_map.x() - radius_m), min_ix_);

@@ -213,8 +213,7 @@ void LaneTracker::DropSpurious(std::size_t frame_index) {
   const std::size_t before = lanes.size();
   lanes.erase(std::remove_if(lanes.begin(), lanes.end(),
                              [&](const LaneElement& e) {
-                               return e.Observations() == 1 &&
-                                      frame_index > e.last_frame + horizon;
+                               return e.Observations() == 1 && frame_index > e.last_frame + horizon;
                              }),
               lanes.end());
   counters_->spurious_dropped += before - lanes.size();

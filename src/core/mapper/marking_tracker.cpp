@@ -55,9 +55,9 @@ void Absorb(MarkingElement* first, const MarkingElement& second) {
               return x.frame_index < y.frame_index;
             });
   first->history.erase(std::unique(first->history.begin(), first->history.end(),
-                                    [](const MarkingMeasurement& x, const MarkingMeasurement& y) {
-                                      return x.frame_index == y.frame_index;
-                                    }),
+                                   [](const MarkingMeasurement& x, const MarkingMeasurement& y) {
+                                     return x.frame_index == y.frame_index;
+                                   }),
                        first->history.end());
   first->first_frame = std::min(first->first_frame, second.first_frame);
   first->last_frame = std::max(first->last_frame, second.last_frame);
@@ -126,7 +126,8 @@ void MarkingTracker::Associate(const std::vector<MarkingObservation>& observatio
   for (const MarkingCandidate& c : candidates) {
     const Eigen::Vector3d center =
         0.25 * (c.corners_map[0] + c.corners_map[1] + c.corners_map[2] + c.corners_map[3]);
-    const double radius = MarkingGateRadius(c, store_->max_retired_cov_trace(), options_.association);
+    const double radius =
+        MarkingGateRadius(c, store_->max_retired_cov_trace(), options_.association);
     for (std::size_t i : store_->RetiredMarkingsNear(center, radius)) retired_near.push_back(i);
   }
   std::sort(retired_near.begin(), retired_near.end());

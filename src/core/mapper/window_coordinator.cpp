@@ -2,8 +2,8 @@
 
 #include <algorithm>
 #include <chrono>
-#include <iterator>
 #include <cmath>
+#include <iterator>
 #include <set>
 #include <unordered_map>
 
@@ -62,8 +62,8 @@ void SliceForWindow(const LaneElement& lane, const std::vector<const LaneMeasure
 }  // namespace
 
 WindowCoordinator::WindowCoordinator(const MapperOptions& options,
-                                     const Eigen::Isometry3d& T_base_cam_initial,
-                                     MapStore* store, MapperCounters* counters)
+                                     const Eigen::Isometry3d& T_base_cam_initial, MapStore* store,
+                                     MapperCounters* counters)
     : options_(options),
       T_base_cam_initial_(T_base_cam_initial),
       T_base_cam_(T_base_cam_initial),
@@ -190,10 +190,12 @@ void WindowCoordinator::FinalGlobalSolve(double time_budget_s) {
   for (const MarkingElement* marking : markings) {
     const MarkingElement& m = *marking;
     if (!m.optimized || m.last_frame < start) continue;
-    WindowMarking wm{m.id, m.corners_map, {}, store_->RoadDirectionAt(m.Center()),
+    WindowMarking wm{m.id,
+                     m.corners_map,
+                     {},
+                     store_->RoadDirectionAt(m.Center()),
                      m.Observations() >= kMinMatureObservations};
-    std::copy_if(m.history.begin(), m.history.end(), std::back_inserter(wm.measurements),
-                 in_span);
+    std::copy_if(m.history.begin(), m.history.end(), std::back_inserter(wm.measurements), in_span);
     snapshot.markings.push_back(std::move(wm));
   }
   const double margin_m = 2.0 * options_.lanes.fit.chord_spacing_m + o.max_lane_pixel_distance_m;
@@ -270,9 +272,9 @@ WindowSnapshot WindowCoordinator::BuildSnapshot() {
     if (l.last_frame < first) continue;
     // The history is sorted by frame: the window's part is its tail.
     const std::size_t from = std::max(lane_first, l.retired_before_frame);
-    auto begin = std::lower_bound(
-        l.history.begin(), l.history.end(), from,
-        [](const LaneMeasurement& m, std::size_t f) { return m.frame_index < f; });
+    auto begin =
+        std::lower_bound(l.history.begin(), l.history.end(), from,
+                         [](const LaneMeasurement& m, std::size_t f) { return m.frame_index < f; });
     std::vector<const LaneMeasurement*> window;
     for (auto it = begin; it != l.history.end(); ++it) window.push_back(&*it);
     WindowLane wl{l.id, 0, {}, {}};

@@ -14,8 +14,8 @@
 #include <array>
 #include <vector>
 
-#include "ipm_road_mapper/core/map/road_map.h"
 #include "ipm_road_mapper/core/io/yaml_options.h"
+#include "ipm_road_mapper/core/map/road_map.h"
 
 namespace ipm_road_mapper {
 

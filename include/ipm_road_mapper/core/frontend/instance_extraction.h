@@ -6,9 +6,9 @@
 #include <string>
 
 #include "ipm_road_mapper/core/frontend/class_table.h"
+#include "ipm_road_mapper/core/frontend/observations.h"
 #include "ipm_road_mapper/core/geometry/ipm.h"
 #include "ipm_road_mapper/core/geometry/ipm_uncertainty.h"
-#include "ipm_road_mapper/core/frontend/observations.h"
 #include "ipm_road_mapper/core/io/yaml_options.h"
 
 namespace ipm_road_mapper {

@@ -26,8 +26,8 @@
 #include <optional>
 #include <string>
 
-#include "ipm_road_mapper/core/map/vector_map.h"
 #include "ipm_road_mapper/core/io/yaml_options.h"
+#include "ipm_road_mapper/core/map/vector_map.h"
 
 namespace ipm_road_mapper {
 

@@ -38,8 +38,7 @@ class MapStore {
   void ReindexRetiredMarkings();
   // Indices of the retired markings whose centers lie within radius_m of p_map (x-y),
   // sorted.
-  std::vector<std::size_t> RetiredMarkingsNear(const Eigen::Vector3d& p_map,
-                                               double radius_m) const;
+  std::vector<std::size_t> RetiredMarkingsNear(const Eigen::Vector3d& p_map, double radius_m) const;
   // The largest trace of a retired marking's center covariance (association's gate radius).
   double max_retired_cov_trace() const { return max_retired_cov_trace_; }
 

@@ -6,14 +6,14 @@
 
 #include <string>
 
-#include "ipm_road_mapper/core/frontend/association.h"
 #include "ipm_road_mapper/core/backend/backend_options.h"
-#include "ipm_road_mapper/core/mapper/input_options.h"
+#include "ipm_road_mapper/core/frontend/association.h"
 #include "ipm_road_mapper/core/frontend/instance_extraction.h"
 #include "ipm_road_mapper/core/geometry/ipm_uncertainty.h"
 #include "ipm_road_mapper/core/geometry/lane_end_fit.h"
 #include "ipm_road_mapper/core/geometry/spline_fitting.h"
 #include "ipm_road_mapper/core/io/yaml_options.h"
+#include "ipm_road_mapper/core/mapper/input_options.h"
 
 namespace ipm_road_mapper {
 
