@@ -7,31 +7,18 @@
 #include <opencv2/imgproc.hpp>
 #include <vector>
 
+#include "common/test_scene.h"
 #include "ipm_road_mapper/core/geometry/ipm.h"
 #include "ipm_road_mapper/core/mapper/mapper.h"
 
 namespace ipm_road_mapper {
 namespace test {
 
-inline CameraIntrinsics TestCamera() {
-  CameraIntrinsics c;
-  c.width = 1280;
-  c.height = 720;
-  c.fx = c.fy = 1000.0;
-  c.cx = 640.0;
-  c.cy = 360.0;
-  return c;
-}
+// The scene's camera (test_scene.h): 1280x720, f = 1000 px, centered.
+inline CameraIntrinsics TestCamera() { return Intrinsics1280x720(); }
 
 // Camera 1.5 m high, 1.5 m ahead of base_link, pitched down 5 degrees.
-inline Eigen::Isometry3d TestExtrinsic() {
-  Eigen::Matrix3d R_base_optical;
-  R_base_optical << 0, 0, 1, -1, 0, 0, 0, -1, 0;
-  Eigen::Isometry3d T = Eigen::Isometry3d::Identity();
-  T.linear() = RotationFromRpy(0.0, 5.0 * M_PI / 180.0, 0.0) * R_base_optical;
-  T.translation() = Eigen::Vector3d(1.5, 0.0, 1.5);
-  return T;
-}
+inline Eigen::Isometry3d TestExtrinsic() { return MountedCamera(0.0, 5.0 * M_PI / 180.0, 0.0); }
 
 inline ClassTable TestClasses() {
   return ClassTable::Load(OptionsReader(YAML::Load(R"(

@@ -106,10 +106,20 @@ TEST(MapStore, RetiredMarkingsLeaveTheLiveSetAndAreFoundByPlace) {
 TEST(MapStore, PruningKeepsCountsAndTheRecentMeasurements) {
   MapStore store(4.0);
   MarkingElement m = MarkingAt(1, 0.0, 0.0, 9);
-  for (std::size_t f = 0; f < 10; ++f) m.history.push_back(MarkingMeasurement{f, {}, {}, {}});
+  for (std::size_t f = 0; f < 10; ++f) {
+    MarkingMeasurement measurement;
+    measurement.frame_index = f;
+    measurement.corners_uv.fill(Eigen::Vector2d::Zero());
+    measurement.corners_base.fill(Eigen::Vector3d::Zero());
+    m.history.push_back(measurement);
+  }
   store.markings().push_back(m);
   LaneElement lane;
-  for (std::size_t f = 0; f < 10; ++f) lane.history.push_back(LaneMeasurement{f, {}, {}, {}});
+  for (std::size_t f = 0; f < 10; ++f) {
+    LaneMeasurement measurement;
+    measurement.frame_index = f;
+    lane.history.push_back(measurement);
+  }
   store.lanes().push_back(lane);
   store.PruneHistoriesBefore(6);
   EXPECT_EQ(store.markings()[0].history.size(), 4u);

@@ -174,6 +174,18 @@ TEST(Mapper, AbsurdMasksAreBounded) {
   EXPECT_GT(c.dropped_instance_limit + c.dropped_unknown_class + c.dropped_tiny, 0u);
 }
 
+TEST(Mapper, ExportCanHoldTheNewestPosesOnly) {
+  Mapper mapper = MakeMapper();
+  for (int k = 0; k < 6; ++k) mapper.ProcessFrame(RoadFrame(100.0 + 0.05 * k, 0.5 * k));
+  EXPECT_EQ(mapper.ExportMap().trajectory.size(), 6u);
+  ExportOptions newest;
+  newest.max_trajectory_poses = 2;
+  const VectorMap map = mapper.ExportMap(newest);
+  ASSERT_EQ(map.trajectory.size(), 2u);
+  EXPECT_DOUBLE_EQ(map.trajectory.back().stamp, 100.25);
+  EXPECT_EQ(map.markings.size(), mapper.ExportMap().markings.size());
+}
+
 TEST(Mapper, ResetDropsTheMapButKeepsMapping) {
   Mapper mapper = MakeMapper();
   for (int k = 0; k < 3; ++k) mapper.ProcessFrame(RoadFrame(100.0 + 0.05 * k, 0.5 * k));

@@ -124,6 +124,8 @@ BackendOptions LoadBackendOptions(OptionsReader reader) {
   reader.Read<double>("map_step_pose_sigma_scale", &o.map_step_pose_sigma_scale, CheckNonNegative);
   reader.Read<int>("final_global_max_frames", &o.final_global_max_frames, CheckPositiveInt);
   reader.Read<int>("final_global_rounds", &o.final_global_rounds, CheckPositiveInt);
+  reader.Read<int>("final_global_min_measurements_per_marking",
+                   &o.final_global_min_measurements_per_marking, CheckPositiveInt);
   reader.RejectUnknownKeys();
   return o;
 }
@@ -183,7 +185,10 @@ std::string ToString(const BackendOptions& o) {
     << "\n"
     << k << "final_global_solve: " << Bool(o.final_global_solve) << "\n"
     << k << "final_global_max_frames: " << o.final_global_max_frames << "\n"
-    << k << "final_global_rounds: " << o.final_global_rounds << "\n";
+    << k << "final_global_rounds: " << o.final_global_rounds << "\n"
+    << k
+    << "final_global_min_measurements_per_marking: " << o.final_global_min_measurements_per_marking
+    << "\n";
   return s.str();
 }
 

@@ -36,42 +36,44 @@ Mapper::Mapper(MapperOptions options, ClassTable classes,
       lanes_(options_, &store_, &counters_),
       windows_(options_, T_base_cam_initial, &store_, &counters_) {}
 
-void Mapper::Skip(const std::string& reason, std::string* out) {
-  const std::string key = reason.substr(0, reason.find(':'));
-  ++counters_.frames_skipped[key];
-  if (out) *out = reason;
-}
-
-void Mapper::CountSkipped(const std::string& reason) {
+void Mapper::CountSkipped(SkipReason reason) {
   ++counters_.frames_received;
-  Skip(reason, nullptr);
+  ++counters_.frames_skipped[ToString(reason)];
 }
 
-std::string Mapper::ValidateInput(const FrameInput& input) const {
-  if (!std::isfinite(input.stamp)) return "bad_stamp: stamp is not finite";
+void Mapper::CountSkipped(const std::string& text) {
+  // "<key>: <detail>" from another layer; a key no layer names is still counted by its name.
+  const std::string key = text.substr(0, text.find(':'));
+  const std::optional<SkipReason> reason = ParseSkipReason(key);
+  ++counters_.frames_received;
+  ++counters_.frames_skipped[reason ? ToString(*reason) : key];
+}
+
+std::optional<Mapper::Invalid> Mapper::ValidateInput(const FrameInput& input) const {
+  if (!std::isfinite(input.stamp)) return Invalid{SkipReason::kBadStamp, "stamp is not finite"};
   if (input.stamp <= last_stamp_) {
     std::ostringstream s;
-    s << "time_jump: stamp " << input.stamp << " s is not after the last frame's " << last_stamp_
-      << " s";
-    return s.str();
+    s << "stamp " << input.stamp << " s is not after the last frame's " << last_stamp_ << " s";
+    return Invalid{SkipReason::kTimeJump, s.str()};
   }
   const std::string camera_error = PinholeCamera(input.camera).Validate();
-  if (!camera_error.empty()) return "bad_camera: " + camera_error;
+  if (!camera_error.empty()) return Invalid{SkipReason::kBadCamera, camera_error};
   const std::string mask_error = ValidateMask(input.mask, input.camera.width, input.camera.height);
-  if (!mask_error.empty()) return "bad_mask: " + mask_error;
+  if (!mask_error.empty()) return Invalid{SkipReason::kBadMask, mask_error};
   if (!IsValidTransform(input.T_map_base_odom)) {
-    return "bad_pose: odometry pose is not finite or not a rotation";
+    return Invalid{SkipReason::kBadPose, "odometry pose is not finite or not a rotation"};
   }
-  return "";
+  return std::nullopt;
 }
 
 FrameStatus Mapper::ProcessFrame(const FrameInput& input, std::string* reason) {
-  ++counters_.frames_received;
-  const std::string error = ValidateInput(input);
-  if (!error.empty()) {
-    Skip(error, reason);
+  const std::optional<Invalid> invalid = ValidateInput(input);
+  if (invalid) {
+    CountSkipped(invalid->reason);
+    if (reason) *reason = SkipText(invalid->reason, invalid->detail);
     return FrameStatus::kSkipped;
   }
+  ++counters_.frames_received;
   last_stamp_ = input.stamp;
   camera_ = input.camera;
   windows_.ApplyResults();
@@ -117,7 +119,7 @@ void Mapper::Reset() {
 
 bool Mapper::Finish(double time_budget_s) { return windows_.Finish(time_budget_s); }
 
-VectorMap Mapper::ExportMap() const {
+VectorMap Mapper::ExportMap(const ExportOptions& export_options) const {
   VectorMap out;
   out.T_base_cam = windows_.T_base_cam();
   out.T_base_cam_initial = T_base_cam_initial_;
@@ -161,8 +163,13 @@ VectorMap Mapper::ExportMap() const {
     lane.last_seen = element.last_seen;
     out.lanes.push_back(std::move(lane));
   }
-  for (const FrameRecord& frame : store_.frames()) {
-    out.trajectory.push_back({frame.stamp, frame.T_map_base});
+  const std::vector<FrameRecord>& frames = store_.frames();
+  const std::size_t max_poses = export_options.max_trajectory_poses;
+  const std::size_t first =
+      max_poses > 0 && frames.size() > max_poses ? frames.size() - max_poses : 0;
+  out.trajectory.reserve(frames.size() - first);
+  for (std::size_t i = first; i < frames.size(); ++i) {
+    out.trajectory.push_back({frames[i].stamp, frames[i].T_map_base});
   }
   out.metadata["method"] = options_.method;
   out.metadata["frames_received"] = counters_.frames_received;

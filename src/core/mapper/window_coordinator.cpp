@@ -216,7 +216,8 @@ void WindowCoordinator::FinalGlobalSolve(double time_budget_s) {
   }
   BackendOptions global = o;
   global.rounds = o.final_global_rounds;
-  global.max_measurements_per_marking = std::max(o.max_measurements_per_marking, 30);
+  global.max_measurements_per_marking =
+      std::max(o.max_measurements_per_marking, o.final_global_min_measurements_per_marking);
   global.max_extrinsic_change_rad = 1e9;  // the trust bound guards windows, not this
   global.max_extrinsic_change_m = 1e9;
   if (!(time_budget_s > 0.0)) return;

@@ -101,6 +101,9 @@ struct BackendOptions {
   bool final_global_solve = true;
   int final_global_max_frames = 1500;
   int final_global_rounds = 3;
+  // The global solve samples at least this many measurements per marking (windows use
+  // max_measurements_per_marking): it sees each marking's whole history at once.
+  int final_global_min_measurements_per_marking = 30;
 };
 
 // Reads the `backend` section; throws OptionsError naming the bad key.

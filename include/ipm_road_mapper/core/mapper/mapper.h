@@ -12,6 +12,7 @@
 #include <cstdint>
 #include <limits>
 #include <opencv2/core.hpp>
+#include <optional>
 #include <string>
 
 #include "ipm_road_mapper/core/backend/backend.h"
@@ -23,6 +24,7 @@
 #include "ipm_road_mapper/core/mapper/mapper_counters.h"
 #include "ipm_road_mapper/core/mapper/mapper_options.h"
 #include "ipm_road_mapper/core/mapper/marking_tracker.h"
+#include "ipm_road_mapper/core/mapper/skip_reason.h"
 #include "ipm_road_mapper/core/mapper/window_coordinator.h"
 
 namespace ipm_road_mapper {
@@ -38,6 +40,13 @@ struct FrameInput {
 // What happened to a frame.
 enum class FrameStatus { kUsed, kSkipped };
 
+// What an export holds beyond the elements.
+struct ExportOptions {
+  // The corrected trajectory's newest poses only (a live snapshot for ~corrected_path);
+  // 0 = every pose (map files).
+  std::size_t max_trajectory_poses = 0;
+};
+
 class Mapper {
  public:
   Mapper(MapperOptions options, ClassTable classes, const Eigen::Isometry3d& T_base_cam_initial);
@@ -50,7 +59,10 @@ class Mapper {
   FrameStatus ProcessFrame(const FrameInput& input, std::string* reason = nullptr);
 
   // Counts a frame the caller could not even build (e.g. no odometry at its stamp).
-  void CountSkipped(const std::string& reason);
+  void CountSkipped(SkipReason reason);
+  // The same from a "<key>: <detail>" text (SkipText); a key that names no SkipReason is
+  // counted under its own name.
+  void CountSkipped(const std::string& text);
 
   // End of input: solves the last window, waits for the optimizer, merges its results and
   // runs the final global solve, within time_budget_s (the nodelet's unload budget; the
@@ -61,7 +73,7 @@ class Mapper {
   // The map as exported (map.json): every element seen at least twice (one seen once is
   // tentative until seen again or dropped as spurious). Lanes that no lane residual refines
   // are re-fit to all their selected pixels, re-IPMed with the current extrinsic and poses.
-  VectorMap ExportMap() const;
+  VectorMap ExportMap(const ExportOptions& options = ExportOptions()) const;
 
   // Optimizer statistics (zeros without a back end).
   BackendStats backend_stats() const { return windows_.stats(); }
@@ -79,8 +91,12 @@ class Mapper {
   const Eigen::Isometry3d& T_base_cam_initial() const { return T_base_cam_initial_; }
 
  private:
-  std::string ValidateInput(const FrameInput& input) const;
-  void Skip(const std::string& reason, std::string* out);
+  // Why an input cannot be used.
+  struct Invalid {
+    SkipReason reason;
+    std::string detail;
+  };
+  std::optional<Invalid> ValidateInput(const FrameInput& input) const;
   // Drops the measurements older than the final solve's span (backend.final_global_max_frames
   // frames) from the histories: no later step reads them, and memory then grows with the
   // map, not with the frames seen.
