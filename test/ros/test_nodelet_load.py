@@ -1,4 +1,4 @@
-#!/usr/bin/env python3
+#!/usr/bin/python3
 """rostest: the mapper nodelet loads with valid parameters and is refused with bad ones."""
 import subprocess
 import unittest
