@@ -339,17 +339,17 @@ void MapperNodelet::SaveAtShutdown(std::chrono::steady_clock::time_point deadlin
   const std::shared_ptr<const VectorMap> map = worker_->Finish(deadline, &finished);
   const std::shared_ptr<const MapSnapshot> latest = worker_->Latest();
   if (!map) {
-    LogFinalSave(false, "nothing to save at shutdown to " + config_.ros.save_map_path + ": " +
-                            latest->status.extrinsic_status);
+    LogFinalSave(false, node_name_ + ": nothing to save at shutdown to " +
+                            config_.ros.save_map_path + ": " + latest->status.extrinsic_status);
     return;
   }
   const MapSaveResult result = saver_->Save(*map, latest->resets);
   if (!result.ok) {
-    LogFinalSave(false,
-                 "cannot save the map at shutdown to " + result.paths.json + ": " + result.message);
+    LogFinalSave(false, node_name_ + ": cannot save the map at shutdown to " + result.paths.json +
+                            ": " + result.message);
     return;
   }
-  LogFinalSave(true, "map saved at shutdown: " + result.message + " (" +
+  LogFinalSave(true, node_name_ + ": map saved at shutdown: " + result.message + " (" +
                          (finished ? "finished map"
                                    : "the last solve ran past ros/shutdown_budget_s: "
                                      "latest snapshot") +
@@ -366,7 +366,7 @@ void MapperNodelet::LogFinalSave(bool ok, const std::string& message) {
   // e.g. ros::shutdown() called by code), rosconsole is shut down and the line above prints
   // nothing: the result still reaches the console.
   if (ros::isShuttingDown() || !ros::ok()) {
-    std::fprintf(stderr, "[%s] %s\n", node_name_.c_str(), message.c_str());
+    std::fprintf(stderr, "%s\n", message.c_str());
   }
 }
 
