@@ -6,8 +6,9 @@ starts. Once an autosave holds markings and lanes, the manager is killed with SI
 the drive still plays; the autosaved files must be complete: the JSON parses (json module and
 the package's reader, evaluate_map), holds markings and lanes, and the GeoJSON and TUM
 siblings are there. A second manager holds two instances, one saving to an unwritable
-path; it is stopped with SIGINT and must log both shutdown saves through rosconsole (the
-failure as [ERROR]) before it exits.
+path, the other reset after its autosave; it is stopped with SIGINT and must log both
+shutdown saves through rosconsole (the failure as [ERROR]) before it exits, and the
+post-reset map must go to map_reset1.json, the autosaved map.json kept.
 """
 import json
 import os
@@ -21,6 +22,7 @@ import unittest
 
 import rospy
 import rostest
+from std_srvs.srv import Trigger
 
 sys.path.insert(0, os.path.dirname(os.path.abspath(__file__)))
 import irm_rostest as irm  # noqa: E402
@@ -123,6 +125,17 @@ class MapperAutosaveTest(unittest.TestCase):
             self.assertEqual(rc, 0, text)
             irm.wait_for(lambda: self.diagnostics.value("bad_saver: saves", "failures", "0")
                          != "0", 30, "a failed autosave on the diagnostics")
+            # ~reset, then the shutdown save of the (empty) post-reset map must not
+            # overwrite the autosaved one.
+            irm.wait_for(lambda: SAVE_STATUS.match(self.diagnostics.value(
+                "good_saver: saves", "last save status", "") or "") and
+                os.path.isfile(good), 30, "an autosave of /good_saver")
+            with open(good) as f:
+                autosaved = json.load(f)
+            self.assertGreater(len(autosaved["markings"]) + len(autosaved["lanes"]), 0)
+            rospy.wait_for_service("/good_saver/reset", timeout=30)
+            reset = rospy.ServiceProxy("/good_saver/reset", Trigger)()
+            self.assertTrue(reset.success, reset.message)
             manager.send_signal(signal.SIGINT)
             rc = manager.wait(30)
         finally:
@@ -134,13 +147,21 @@ class MapperAutosaveTest(unittest.TestCase):
         print(text[-3000:])
         self.assertEqual(rc, 0, text[-3000:])
         # Through rosconsole ("[ INFO] [...]:", "[ERROR] [...]:"), not only on stderr.
-        self.assertRegex(text, r"\[ INFO\] [^\n]*map saved at shutdown: \d+ markings, \d+ lanes "
-                               r"to " + re.escape(good))
+        after_reset = good[:-len(".json")] + "_reset1.json"
+        self.assertRegex(text, r"\[ INFO\] [^\n]*map saved at shutdown: 0 markings, 0 lanes "
+                               r"to " + re.escape(after_reset))
+        self.assertRegex(text, r"\[ WARN\] [^\n]*after ~reset 1 has fewer elements")
         self.assertRegex(text, r"\[ERROR\] [^\n]*cannot save the map at shutdown to " +
                          re.escape(bad) + r"[^\n]*" + re.escape(blocker))
         self.assertRegex(text, r"autosave to " + re.escape(bad) + " failed")
-        with open(good) as f:
-            self.assertGreater(len(json.load(f)["trajectory"]), 0)
+        with open(good) as f:  # the pre-reset map is still there
+            kept = json.load(f)
+        self.assertEqual(len(kept["markings"]) + len(kept["lanes"]),
+                         len(autosaved["markings"]) + len(autosaved["lanes"]))
+        with open(after_reset) as f:
+            self.assertEqual(len(json.load(f)["markings"]), 0)
+        for sibling in ("_reset1.geojson", "_reset1_trajectory_tum.txt"):
+            self.assertTrue(os.path.isfile(good[:-len(".json")] + sibling), sibling)
 
 
 if __name__ == "__main__":
