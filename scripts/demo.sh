@@ -98,7 +98,7 @@ fi
   --out "$out/mapper/map.png"
 echo
 echo "[demo] files:"
-for f in mapper/map.json mapper/map.geojson mapper/trajectory_tum.txt mapper/metrics.json \
+for f in mapper/map.json mapper/map.geojson mapper/map_trajectory_tum.txt mapper/metrics.json \
          mapper/map.png mapper/summary.txt drive/drive.bag drive/ground_truth.json; do
   echo "  $out/$f"
 done

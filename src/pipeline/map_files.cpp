@@ -1,7 +1,17 @@
 #include "ipm_road_mapper/pipeline/map_files.h"
 
+#include <fcntl.h>
+#include <unistd.h>
+
+#include <atomic>
+#include <cerrno>
+#include <cstdio>
+#include <cstring>
 #include <filesystem>
+#include <set>
 #include <stdexcept>
+#include <utility>
+#include <vector>
 
 namespace ipm_road_mapper {
 namespace {
@@ -18,6 +28,26 @@ void CreateParent(const std::string& path) {
   }
 }
 
+// A name in the folder of `path` that no other save (thread or process) uses at once.
+std::string TemporarySibling(const std::string& path) {
+  static std::atomic<std::uint64_t> counter{0};
+  const fs::path p(path);
+  const std::string name = "." + p.filename().string() + ".saving." + std::to_string(::getpid()) +
+                           "." + std::to_string(++counter);
+  return (p.parent_path() / name).string();
+}
+
+// fsync of a folder, so that a rename in it survives a power loss (best effort: some file
+// systems refuse to open folders for reading).
+void SyncFolder(const std::string& path) {
+  std::string folder = fs::path(path).parent_path().string();
+  if (folder.empty()) folder = ".";
+  const int fd = ::open(folder.c_str(), O_RDONLY | O_DIRECTORY);
+  if (fd < 0) return;
+  ::fsync(fd);
+  ::close(fd);
+}
+
 }  // namespace
 
 MapFilePaths MapFilePathsFor(const std::string& json_path) {
@@ -31,17 +61,75 @@ MapFilePaths MapFilePathsFor(const std::string& json_path) {
 }
 
 MapFilePaths MapFilePathsInFolder(const std::string& folder) {
-  const fs::path dir(folder);
-  return {(dir / "map.json").string(), (dir / "map.geojson").string(),
-          (dir / "trajectory_tum.txt").string()};
+  return MapFilePathsFor((fs::path(folder) / "map.json").string());
+}
+
+MapFilePaths MapFilePathsAfterReset(const std::string& json_path, std::uint64_t reset) {
+  const MapFilePaths base = MapFilePathsFor(json_path);
+  const std::string stem = base.json.substr(0, base.json.size() - 5);  // without ".json"
+  return MapFilePathsFor(stem + "_reset" + std::to_string(reset) + ".json");
 }
 
 void SaveMapFiles(const VectorMap& map, const std::optional<GeoOrigin>& geo_origin,
                   const MapFilePaths& paths) {
   for (const std::string* path : {&paths.json, &paths.geojson, &paths.tum}) CreateParent(*path);
-  SaveVectorMapJson(map, paths.json);
-  SaveGeoJson(map, geo_origin, paths.geojson);
-  WriteTumTrajectory(map.trajectory, paths.tum);
+  const MapFilePaths temp{TemporarySibling(paths.json), TemporarySibling(paths.geojson),
+                          TemporarySibling(paths.tum)};
+  auto remove_temporaries = [&] {
+    for (const std::string* path : {&temp.json, &temp.geojson, &temp.tum}) {
+      std::remove(path->c_str());
+    }
+  };
+  // Each core writer is atomic and fsyncs its file; here under the temporary names.
+  try {
+    SaveVectorMapJson(map, temp.json);
+    SaveGeoJson(map, geo_origin, temp.geojson);
+    WriteTumTrajectory(map.trajectory, temp.tum);
+  } catch (const std::exception& e) {
+    remove_temporaries();
+    // The core names the temporary file; the caller asked for the real one.
+    std::string what = e.what();
+    for (const auto& [from, to] :
+         {std::pair{temp.json, paths.json}, std::pair{temp.geojson, paths.geojson},
+          std::pair{temp.tum, paths.tum}}) {
+      for (std::size_t at = what.find(from); at != std::string::npos; at = what.find(from)) {
+        what.replace(at, from.size(), to);
+      }
+    }
+    throw std::runtime_error(what);
+  }
+  const std::vector<std::pair<std::string, std::string>> moves = {
+      {temp.json, paths.json}, {temp.geojson, paths.geojson}, {temp.tum, paths.tum}};
+  for (const auto& [from, to] : moves) {
+    if (std::rename(from.c_str(), to.c_str()) != 0) {
+      const std::string reason = std::strerror(errno);
+      remove_temporaries();
+      throw std::runtime_error(to + ": cannot rename the temporary file into place: " + reason);
+    }
+  }
+  std::set<std::string> folders;
+  for (const auto& move : moves) folders.insert(fs::path(move.second).parent_path().string());
+  for (const std::string& folder : folders) SyncFolder((fs::path(folder) / "x").string());
+}
+
+std::size_t MapElementCount(const VectorMap& map) { return map.markings.size() + map.lanes.size(); }
+
+MapSaveTarget::MapSaveTarget(std::string json_path) : json_path_(std::move(json_path)) {}
+
+MapFilePaths MapSaveTarget::Choose(std::uint64_t generation, std::size_t elements, bool* diverted) {
+  auto known = diverted_.find(generation);
+  if (known == diverted_.end()) {
+    const bool fewer = last_saved_elements_ && elements < *last_saved_elements_;
+    known = diverted_.emplace(generation, generation > 0 && fewer).first;
+  }
+  *diverted = known->second;
+  return known->second ? MapFilePathsAfterReset(json_path_, generation)
+                       : MapFilePathsFor(json_path_);
+}
+
+void MapSaveTarget::Saved(std::uint64_t generation, std::size_t elements) {
+  diverted_.emplace(generation, false);  // chosen already when Choose was called
+  last_saved_elements_ = elements;
 }
 
 }  // namespace ipm_road_mapper

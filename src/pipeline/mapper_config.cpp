@@ -52,6 +52,7 @@ RosOptions LoadRosOptions(OptionsReader reader) {
   reader.Read<int>("input_queue_size", &o.input_queue_size, CheckQueueSize);
   reader.Read<double>("marker_full_period_s", &o.marker_full_period_s, CheckPositive);
   reader.Read<double>("shutdown_budget_s", &o.shutdown_budget_s, CheckPositive);
+  reader.Read<double>("autosave_period_s", &o.autosave_period_s, CheckNonNegative);
   reader.RejectUnknownKeys();
   return o;
 }
@@ -108,7 +109,9 @@ std::string ToString(const RosOptions& o) {
     << "ros.debug_image_rate_hz: " << o.debug_image_rate_hz << "\n"
     << "ros.input_queue_size: " << o.input_queue_size << "\n"
     << "ros.marker_full_period_s: " << o.marker_full_period_s << "\n"
-    << "ros.shutdown_budget_s: " << o.shutdown_budget_s << "\n";
+    << "ros.shutdown_budget_s: " << o.shutdown_budget_s << "\n"
+    << "ros.autosave_period_s: " << o.autosave_period_s
+    << (o.autosave_period_s > 0.0 ? "" : " (off: saved at shutdown only)") << "\n";
   return s.str();
 }
 

@@ -137,6 +137,30 @@ void FillExtrinsicStatus(const MapperStatusSnapshot& now, DiagnosticStatusWrappe
   s->summary(DiagnosticStatus::OK, "known");
 }
 
+void FillSaveStatus(const MapSaveStatus& save, double wall_now, DiagnosticStatusWrapper* s) {
+  if (save.path.empty()) {
+    s->summary(DiagnosticStatus::OK, "off (ros/save_map_path not set)");
+    return;
+  }
+  s->add("path", save.path);
+  s->addf("autosave period (s)", "%.1f", save.autosave_period_s);
+  s->add("saves", save.saves);
+  s->add("failures", save.failures);
+  if (save.last_wall_time <= 0.0) {
+    s->add("last save wall time", "none yet");
+    s->summary(DiagnosticStatus::OK, "no save yet");
+    return;
+  }
+  s->addf("last save wall time", "%.3f", save.last_wall_time);
+  s->addf("last save age (s)", "%.1f", std::max(0.0, wall_now - save.last_wall_time));
+  s->add("last save status", save.last_status);
+  if (save.last_ok) {
+    s->summary(DiagnosticStatus::OK, "ok");
+  } else {
+    s->summary(DiagnosticStatus::ERROR, "last save failed: " + save.last_status);
+  }
+}
+
 MapperDiagnostics::MapperDiagnostics(ros::NodeHandle& nh, ros::NodeHandle& private_nh,
                                      const std::string& name,
                                      std::function<MapperStatusSnapshot()> snapshot)
@@ -160,6 +184,12 @@ MapperDiagnostics::MapperDiagnostics(ros::NodeHandle& nh, ros::NodeHandle& priva
                }));
   updater_.add("extrinsic",
                task([this](DiagnosticStatusWrapper& s) { FillExtrinsicStatus(now_, &s); }));
+  updater_.add("saves", task([this](DiagnosticStatusWrapper& s) {
+                 const double wall_now = std::chrono::duration<double>(
+                                             std::chrono::system_clock::now().time_since_epoch())
+                                             .count();
+                 FillSaveStatus(now_.save, wall_now, &s);
+               }));
 }
 
 void MapperDiagnostics::Update() {

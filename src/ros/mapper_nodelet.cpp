@@ -53,6 +53,12 @@ void MapperNodelet::onInit() {
   hooks.overlay_wanted = [this] { return debug_image_ && debug_image_->active(); };
   // The mapping thread starts idle; inputs reach it only once SetUpInputs subscribed.
   worker_ = std::make_unique<MappingWorker>(config_, classes_, node_name_, lookup, hooks);
+  if (!config_.ros.save_map_path.empty()) {
+    saver_ = std::make_unique<MapSaver>(
+        config_.ros.save_map_path, config_.geo_origin, config_.ros.autosave_period_s, node_name_,
+        [this] { return worker_->Latest(); },
+        [this] { SaveAtShutdown(std::chrono::steady_clock::now() + ShutdownBudget()); });
+  }
   SetUpOutputs();
   SetUpInputs();
   NODELET_INFO("%s: waiting for %s (+ %s) and %s; %s sync", node_name_.c_str(),
@@ -279,13 +285,17 @@ MapperStatusSnapshot MapperNodelet::Snapshot() {
   s.publish_cpu_last_ms = publish_cpu_last_ms_;
   s.publish_cpu_mean_ms = publishes_ ? publish_cpu_total_ms_ / publishes_ : 0.0;
   s.publish_cpu_max_ms = publish_cpu_max_ms_;
+  if (saver_) s.save = saver_->status();
   return s;
 }
 
+std::chrono::steady_clock::duration MapperNodelet::ShutdownBudget() const {
+  return std::chrono::duration_cast<std::chrono::steady_clock::duration>(
+      std::chrono::duration<double>(config_.ros.shutdown_budget_s));
+}
+
 void MapperNodelet::Shutdown() {
-  const auto deadline = std::chrono::steady_clock::now() +
-                        std::chrono::duration_cast<std::chrono::steady_clock::duration>(
-                            std::chrono::duration<double>(config_.ros.shutdown_budget_s));
+  const auto deadline = std::chrono::steady_clock::now() + ShutdownBudget();
   shutting_down_ = true;
   if (worker_) worker_->CloseInputs();  // a waiting ~reset answers at once
   // Stop everything that calls into this object; each call waits for a running callback
@@ -299,7 +309,8 @@ void MapperNodelet::Shutdown() {
   info_sub_.unsubscribe();
   if (debug_image_) debug_image_->Shutdown();
   if (output_spinner_) output_spinner_->stop();  // joins the output thread
-  if (worker_ && !config_.ros.save_map_path.empty()) SaveAtShutdown(deadline);
+  if (saver_) saver_->Stop();  // joins the saver thread (a SIGINT save in it completes)
+  if (worker_ && saver_) SaveAtShutdown(deadline);
   if (worker_) worker_->Stop();  // joins the mapping thread
   if (callbacks_ > 0) {
     NODELET_INFO(
@@ -311,6 +322,7 @@ void MapperNodelet::Shutdown() {
   }
   exact_sync_.reset();
   approximate_sync_.reset();
+  saver_.reset();
   worker_.reset();  // the session: the Mapper's optimizer thread is stopped and joined here
   tf_listener_.reset();
   tf_buffer_.reset();
@@ -320,36 +332,41 @@ void MapperNodelet::Shutdown() {
 }
 
 void MapperNodelet::SaveAtShutdown(std::chrono::steady_clock::time_point deadline) {
+  std::lock_guard<std::mutex> lock(final_save_mutex_);
+  if (final_save_done_) return;
+  final_save_done_ = true;
   bool finished = false;
   const std::shared_ptr<const VectorMap> map = worker_->Finish(deadline, &finished);
-  const std::string& path = config_.ros.save_map_path;
-  std::string message;
-  bool ok = false;
+  const std::shared_ptr<const MapSnapshot> latest = worker_->Latest();
   if (!map) {
-    message = "nothing to save at shutdown: " + worker_->Latest()->status.extrinsic_status;
-  } else {
-    try {
-      SaveMapFiles(*map, config_.geo_origin, MapFilePathsFor(path));
-      ok = true;
-      message = "map saved at shutdown: " + path + " (" + std::to_string(map->markings.size()) +
-                " markings, " + std::to_string(map->lanes.size()) + " lanes; " +
-                (finished ? "finished map"
-                          : "the last solve ran past ros/shutdown_budget_s: "
-                            "latest snapshot") +
-                ")";
-    } catch (const std::exception& e) {
-      message = std::string("cannot save the map at shutdown: ") + e.what();
-    }
+    LogFinalSave(false, node_name_ + ": nothing to save at shutdown to " +
+                            config_.ros.save_map_path + ": " + latest->status.extrinsic_status);
+    return;
   }
+  const MapSaveResult result = saver_->Save(*map, latest->resets);
+  if (!result.ok) {
+    LogFinalSave(false, node_name_ + ": cannot save the map at shutdown to " + result.paths.json +
+                            ": " + result.message);
+    return;
+  }
+  LogFinalSave(true, node_name_ + ": map saved at shutdown: " + result.message + " (" +
+                         (finished ? "finished map"
+                                   : "the last solve ran past ros/shutdown_budget_s: "
+                                     "latest snapshot") +
+                         ")");
+}
+
+void MapperNodelet::LogFinalSave(bool ok, const std::string& message) {
   if (ok) {
     NODELET_INFO("%s", message.c_str());
   } else {
     NODELET_ERROR("%s", message.c_str());
   }
-  // Once ros::shutdown began (a manager or mapper_node exiting on SIGINT), rosconsole is
-  // shut down and the line above prints nothing: the result still reaches the console.
+  // Once ros::shutdown began (a manager or mapper_node exiting without the SIGINT save,
+  // e.g. ros::shutdown() called by code), rosconsole is shut down and the line above prints
+  // nothing: the result still reaches the console.
   if (ros::isShuttingDown() || !ros::ok()) {
-    std::fprintf(stderr, "[%s] %s\n", node_name_.c_str(), message.c_str());
+    std::fprintf(stderr, "%s\n", message.c_str());
   }
 }
 

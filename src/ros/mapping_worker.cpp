@@ -137,6 +137,7 @@ bool MappingWorker::RunCommands() {
   if (reset) {
     session_.Reset();
     ++map_version_;
+    ++generation_;
     Export();  // the services and timers see the empty map at once
     {
       std::lock_guard<std::mutex> lock(command_mutex_);
@@ -291,6 +292,7 @@ void MappingWorker::Export() {
   auto snapshot = std::make_shared<MapSnapshot>();
   snapshot->map = exported_map_;
   snapshot->map_version = map_version_;
+  snapshot->resets = generation_;
   snapshot->newest_frame_stamp = newest_frame_stamp_;
   snapshot->map_frame = map_frame_.empty() ? "map" : map_frame_;
   snapshot->refined_camera_frame = refined_frame_;

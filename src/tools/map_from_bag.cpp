@@ -13,7 +13,7 @@
 // identical stamp; approximate: nearest within half the period of the first camera_infos)
 // and with odometry interpolated at its stamp (FrameAssembler, the same code the nodelet
 // uses), runs the core Mapper, and writes <dir>/map.json, <dir>/map.geojson,
-// <dir>/trajectory_tum.txt and <dir>/summary.txt (with startup_s: process start to the first
+// <dir>/map_trajectory_tum.txt and <dir>/summary.txt (with startup_s: process start to the first
 // frame mapped), and with --stats-out a CSV row per frame (CPU time, RSS). The rough
 // extrinsic T_base_cam is the config's input.extrinsic when given, else the bag's /tf_static
 // transform from input.base_frame to the mask's header.frame_id (a chain of static transforms
@@ -212,7 +212,7 @@ std::string Summary(const Arguments& args, const Mapper& mapper, const FrameAsse
     << (stats.wall_s > 0 ? stats.frames_read / stats.wall_s : 0.0) << " frames/s; bag span "
     << stats.bag_span_s << " s; real-time factor "
     << (stats.wall_s > 0 ? stats.bag_span_s / stats.wall_s : 0.0) << "x\n"
-    << "outputs: " << args.out << "/{map.json, map.geojson, trajectory_tum.txt, summary.txt}"
+    << "outputs: " << args.out << "/{map.json, map.geojson, map_trajectory_tum.txt, summary.txt}"
     << (args.stats_out.empty() ? "" : ", " + args.stats_out) << "\n";
   return s.str();
 }

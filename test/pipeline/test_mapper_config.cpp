@@ -78,6 +78,17 @@ TEST(MapperConfig, TopicsAndSyncAreRosOptions) {
   EXPECT_NE(ErrorOf("input: {sync: exact}").find("input.sync"), std::string::npos);
 }
 
+TEST(MapperConfig, AutosavePeriodIsValidated) {
+  EXPECT_DOUBLE_EQ(RosOptions().autosave_period_s, 30.0);
+  EXPECT_DOUBLE_EQ(Load("ros: {autosave_period_s: 2.5}").ros.autosave_period_s, 2.5);
+  EXPECT_DOUBLE_EQ(Load("ros: {autosave_period_s: 0}").ros.autosave_period_s, 0.0);  // off
+  EXPECT_NE(ErrorOf("ros: {autosave_period_s: -1}").find("ros.autosave_period_s"),
+            std::string::npos);
+  EXPECT_NE(ErrorOf("ros: {autosave_period_s: .nan}").find("ros.autosave_period_s"),
+            std::string::npos);
+  EXPECT_NE(ToString(RosOptions()).find("ros.autosave_period_s: 30"), std::string::npos);
+}
+
 TEST(MapperConfig, ThreadingOptionsAreValidated) {
   const RosOptions defaults;
   EXPECT_DOUBLE_EQ(defaults.shutdown_budget_s, 3.0);

@@ -132,5 +132,41 @@ TEST(MapperDiagnostics, ExtrinsicChangeAndSolveTimes) {
   EXPECT_EQ(w.level, DiagnosticStatus::WARN);
 }
 
+TEST(MapperDiagnostics, SavesShowTheLastSaveAndAFailureIsAnError) {
+  DiagnosticStatusWrapper off;
+  FillSaveStatus(MapSaveStatus(), 100.0, &off);
+  EXPECT_EQ(off.level, DiagnosticStatus::OK);
+  EXPECT_NE(off.message.find("off"), std::string::npos);
+
+  MapSaveStatus save;
+  save.path = "/tmp/live.json";
+  save.autosave_period_s = 2.0;
+  DiagnosticStatusWrapper none;
+  FillSaveStatus(save, 100.0, &none);
+  EXPECT_EQ(none.level, DiagnosticStatus::OK);
+  EXPECT_EQ(Value(none, "last save wall time"), "none yet");
+
+  save.saves = 3;
+  save.last_wall_time = 1000.0;
+  save.last_ok = true;
+  save.last_status = "ok: 4 markings, 2 lanes to /tmp/live.json";
+  DiagnosticStatusWrapper ok;
+  FillSaveStatus(save, 1002.5, &ok);
+  EXPECT_EQ(ok.level, DiagnosticStatus::OK);
+  EXPECT_EQ(Value(ok, "path"), "/tmp/live.json");
+  EXPECT_EQ(Value(ok, "last save wall time"), "1000.000");
+  EXPECT_EQ(Value(ok, "last save age (s)"), "2.5");
+  EXPECT_EQ(Value(ok, "last save status"), save.last_status);
+
+  save.failures = 1;
+  save.last_ok = false;
+  save.last_status = "/tmp/live.json: cannot create folder: Not a directory";
+  DiagnosticStatusWrapper failed;
+  FillSaveStatus(save, 1003.0, &failed);
+  EXPECT_EQ(failed.level, DiagnosticStatus::ERROR);
+  EXPECT_NE(failed.message.find("Not a directory"), std::string::npos);
+  EXPECT_EQ(Value(failed, "failures"), "1");
+}
+
 }  // namespace
 }  // namespace ipm_road_mapper

@@ -147,11 +147,13 @@ TEST(MappingWorker, ResetIsACommandOfTheMappingThread) {
   Feed(&worker, 5);
   ASSERT_TRUE(WaitForSnapshot(
       worker, [](const MapSnapshot& s) { return s.map && s.map->trajectory.size() == 5; }));
+  EXPECT_EQ(worker.Latest()->resets, 0u);
   std::string message;
   EXPECT_TRUE(worker.Reset(2.0, &message)) << message;
   const auto after = worker.Latest();  // swapped in before Reset returned
   ASSERT_NE(after->map, nullptr);
   EXPECT_TRUE(after->map->trajectory.empty());
+  EXPECT_EQ(after->resets, 1u);  // the generation the saver files post-reset maps by
 }
 
 TEST(MappingWorker, FinishReturnsTheFinishedMapAndStopJoins) {

@@ -65,7 +65,7 @@ best = min(m["markings"], key=lambda k: (sum(c[0] for c in k["corners"]) / 4 - 1
 cx = sum(c[0] for c in best["corners"]) / 4
 cy = sum(c[1] for c in best["corners"]) / 4
 assert abs(cx - 19.5) < 0.5 and abs(cy) < 0.3, f"marking center ({cx:.2f}, {cy:.2f})"
-rows = [l.split() for l in open(out + "/trajectory_tum.txt") if not l.startswith("#")]
+rows = [l.split() for l in open(out + "/map_trajectory_tum.txt") if not l.startswith("#")]
 assert len(rows) == 25 and all(len(r) == 8 for r in rows), f"{len(rows)} TUM rows"
 print(f"ok: map.json: {len(m['markings'])} markings, {len(m['lanes'])} lanes; "
       f"arrow center ({cx:.2f}, {cy:.2f}); 25 TUM poses")
@@ -126,7 +126,7 @@ EOF
 if run_mapper --bag "$work/drive.bag" --out "$work/out" >"$work/summary.log" 2>"$work/progress.log"; then
   pass "map_from_bag on drive.bag (default config)"
   cat "$work/summary.log"
-  for file in map.json map.geojson trajectory_tum.txt summary.txt; do
+  for file in map.json map.geojson map_trajectory_tum.txt summary.txt; do
     [ -s "$work/out/$file" ] || fail "$file missing or empty"
   done
   grep -q "^frames read: 25$" "$work/out/summary.txt" || fail "summary: frames read is not 25"

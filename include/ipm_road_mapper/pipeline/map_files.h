@@ -1,8 +1,14 @@
 // Writing a finished map to disk, the same way for the offline runner (map_from_bag --out)
-// and the nodelet (~save_map, and at shutdown): the map JSON, its GeoJSON and the corrected
-// trajectory in TUM format, each written atomically by the core's writers. No ROS header.
+// and the nodelet (~save_map, the autosave and at shutdown): the map JSON, its GeoJSON and
+// the corrected trajectory in TUM format, named by one rule (MapFilePathsFor). A save is
+// atomic per file and all-or-nothing for the three: each is written and fsynced under a
+// temporary name in its own folder first, then the three are renamed into place. Also the
+// rule that keeps a live map saved before a ~reset (MapSaveTarget). No ROS header.
 #pragma once
 
+#include <cstddef>
+#include <cstdint>
+#include <map>
 #include <optional>
 #include <string>
 
@@ -18,17 +24,54 @@ struct MapFilePaths {
   std::string tum;      // corrected T_map_base per used frame
 };
 
-// The files of a map saved as `json_path` (the ~save_map convention): "<stem>.json",
-// "<stem>.geojson" and "<stem>_trajectory_tum.txt", where <stem> is json_path without a
-// trailing ".json". Example: /tmp/m.json -> /tmp/m.geojson, /tmp/m_trajectory_tum.txt.
+// The files of a map saved as `json_path`: "<stem>.json", "<stem>.geojson" and
+// "<stem>_trajectory_tum.txt", where <stem> is json_path without a trailing ".json".
+// Example: /tmp/m.json -> /tmp/m.geojson, /tmp/m_trajectory_tum.txt.
 MapFilePaths MapFilePathsFor(const std::string& json_path);
 
-// The files of map_from_bag's output folder: map.json, map.geojson, trajectory_tum.txt.
+// The files of map_from_bag's output folder, by the same rule: map.json, map.geojson,
+// map_trajectory_tum.txt.
 MapFilePaths MapFilePathsInFolder(const std::string& folder);
 
-// Creates the parent folders and writes the three files. Throws std::runtime_error naming
-// the file that could not be written.
+// The files of the map made after the `reset`-th ~reset of a live session saving to
+// `json_path`: "<stem>_reset<reset>.json" and its siblings (MapFilePathsFor).
+MapFilePaths MapFilePathsAfterReset(const std::string& json_path, std::uint64_t reset);
+
+// Creates the parent folders and writes the three files: all three under temporary names
+// (each fsynced), then renamed into place (json, geojson, tum: the TUM file is the last to
+// appear) and the folders fsynced. When any of them cannot be written, none of the
+// existing files is replaced. Throws std::runtime_error naming the file and the reason.
 void SaveMapFiles(const VectorMap& map, const std::optional<GeoOrigin>& geo_origin,
                   const MapFilePaths& paths);
+
+// Markings + lanes: what "a map with fewer elements" counts.
+std::size_t MapElementCount(const VectorMap& map);
+
+// Which files a live session's saves go to, so that a ~reset never erases a saved map.
+// Saves are tagged with the number of resets before their map (its generation). A save of
+// generation g > 0 whose map has fewer elements than the last save made is diverted to
+// MapFilePathsAfterReset(json_path, g), and every later save of that generation follows
+// it there; otherwise (generation 0, or a post-reset map at least as large) the save goes
+// to json_path. Not thread-safe: one saver at a time.
+class MapSaveTarget {
+ public:
+  // `json_path`: ros/save_map_path.
+  explicit MapSaveTarget(std::string json_path);
+
+  // The files for a map of `elements` elements made after `generation` resets; *diverted
+  // is set when they are not json_path's (a post-reset map kept apart).
+  MapFilePaths Choose(std::uint64_t generation, std::size_t elements, bool* diverted);
+
+  // Records a successful save of a map of `elements` elements of `generation`.
+  void Saved(std::uint64_t generation, std::size_t elements);
+
+  // The configured path (ros/save_map_path).
+  const std::string& json_path() const { return json_path_; }
+
+ private:
+  const std::string json_path_;
+  std::optional<std::size_t> last_saved_elements_;  // of the last save, whatever its files
+  std::map<std::uint64_t, bool> diverted_;          // per generation, once its files are chosen
+};
 
 }  // namespace ipm_road_mapper

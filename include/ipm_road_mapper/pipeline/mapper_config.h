@@ -26,7 +26,7 @@ struct RosOptions {
   double publish_rate_hz = 2.0;      // ~vector_map, ~markers, ~corrected_path, refined tf
   std::string map_frame;             // frame of the published map; "" = odometry header.frame_id
   std::string refined_camera_frame;  // tf child of the refined extrinsic; "" = <camera>_refined
-  std::string save_map_path;         // the map is written here at shutdown when not empty
+  std::string save_map_path;         // the map is written here (autosave, shutdown) when set
   std::string classes_file;          // class table; "" = the package's config/classes.yaml
   int sync_queue_size = 10;          // message_filters queue of mask <-> camera_info pairing
   double approximate_sync_max_interval_s = 0.025;  // sync: approximate, largest stamp gap
@@ -48,6 +48,9 @@ struct RosOptions {
   // Unload / shutdown with save_map_path: the time the last solve may take before the
   // latest snapshot is saved instead.
   double shutdown_budget_s = 3.0;
+  // With save_map_path: the latest snapshot is also saved this often (s, wall time) by an
+  // owned saver thread, so a crash loses at most one period; 0 = only at shutdown.
+  double autosave_period_s = 30.0;
 };
 
 // Everything a runner is configured with.

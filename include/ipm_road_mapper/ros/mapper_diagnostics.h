@@ -4,7 +4,9 @@
 //                       sync (no camera_info), odometry counters, callback time;
 //   "<node>: optimizer" windows submitted / solved / dropped / unusable, solve time;
 //   "<node>: extrinsic" where the rough extrinsic came from, and how far the refined one
-//                       moved from it.
+//                       moved from it;
+//   "<node>: saves"     the ros/save_map_path saves (autosave, shutdown): the last one's
+//                       wall time, age and status (ok / the error).
 // The status functions are pure (snapshot -> DiagnosticStatusWrapper) and unit-tested.
 #pragma once
 
@@ -37,6 +39,16 @@ struct InputStats {
   std::array<double, kMapperInputCount> rates_hz{};
 };
 
+// The saves to ros/save_map_path so far (MapSaver).
+struct MapSaveStatus {
+  std::string path;                // ros/save_map_path; "" = saving is off
+  double autosave_period_s = 0.0;  // 0 = at shutdown only
+  std::uint64_t saves = 0, failures = 0;
+  double last_wall_time = 0.0;  // UNIX time (s) of the last attempt; 0 = none yet
+  bool last_ok = false;
+  std::string last_status;  // "ok: <files>" or the error of the last attempt
+};
+
 // The mapper's state as the diagnostics see it, copied under the nodelet's lock.
 struct MapperStatusSnapshot {
   bool started = false;
@@ -54,9 +66,10 @@ struct MapperStatusSnapshot {
   std::array<std::uint64_t, 3> inputs_dropped{};  // input queue full: frames, odometry, images
   std::uint64_t publishes = 0;                    // map publications (timer cycles that sent)
   double publish_cpu_last_ms = 0.0, publish_cpu_mean_ms = 0.0, publish_cpu_max_ms = 0.0;
+  MapSaveStatus save;
 };
 
-// The four statuses (see the file comment). `previous` is the snapshot of the last update,
+// The statuses (see the file comment). `previous` is the snapshot of the last update,
 // to tell what happened during the period (levels: WARN when frames arrived but none was
 // used, or the optimizer rejected a result since the last update).
 void FillInputStatus(const InputStats& inputs, diagnostic_updater::DiagnosticStatusWrapper* s);
@@ -66,6 +79,9 @@ void FillOptimizerStatus(const MapperStatusSnapshot& now, const MapperStatusSnap
                          diagnostic_updater::DiagnosticStatusWrapper* s);
 void FillExtrinsicStatus(const MapperStatusSnapshot& now,
                          diagnostic_updater::DiagnosticStatusWrapper* s);
+// `wall_now`: UNIX time (s), for the age of the last save. ERROR while the last save failed.
+void FillSaveStatus(const MapSaveStatus& save, double wall_now,
+                    diagnostic_updater::DiagnosticStatusWrapper* s);
 
 // Owns the Updater; Count() may be called from any thread.
 class MapperDiagnostics {

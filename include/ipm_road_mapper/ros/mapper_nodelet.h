@@ -13,7 +13,9 @@
 // (the service waits at most 2 s). The Mapper's optimizer is its own thread.
 // Unload: inputs, timers and services stop; with ros/save_map_path the mapping thread
 // finishes within ros/shutdown_budget_s and the best map available is saved; the mapping
-// thread is joined.
+// thread is joined. With ros/save_map_path the MapSaver's thread also saves the latest
+// snapshot every ros/autosave_period_s, and on SIGINT runs that final save before roscpp
+// shuts down (and its logging with it), then passes the signal on.
 // Why not the nodelet's multi-threaded queue: nodelet's queues hold the nodelet through a
 // weak_ptr locked per callback, so an unload during a data callback destroys the nodelet at
 // the end of that callback, in a worker thread, when its other queue may already be freed;
@@ -48,6 +50,7 @@
 #include "ipm_road_mapper/pipeline/mapper_config.h"
 #include "ipm_road_mapper/ros/debug_image_publisher.h"
 #include "ipm_road_mapper/ros/map_publisher.h"
+#include "ipm_road_mapper/ros/map_saver.h"
 #include "ipm_road_mapper/ros/mapper_diagnostics.h"
 #include "ipm_road_mapper/ros/mapping_worker.h"
 
@@ -86,16 +89,21 @@ class MapperNodelet : public nodelet::Nodelet {
   bool OnReset(std_srvs::Trigger::Request& request, std_srvs::Trigger::Response& response);
   // The latest snapshot's status plus the callback, queue and publish figures.
   MapperStatusSnapshot Snapshot();
+  std::chrono::steady_clock::duration ShutdownBudget() const;
   void Shutdown();
   // With ros/save_map_path: the mapping thread finishes until `deadline`, the best map
-  // available is saved, and the result logged.
+  // available is saved, and the result logged. Once only (SIGINT or unload, whichever first).
   void SaveAtShutdown(std::chrono::steady_clock::time_point deadline);
+  // Logs the final save's result (also on stderr once rosconsole is shut down).
+  void LogFinalSave(bool ok, const std::string& message);
 
   MapperConfig config_;
   ClassTable classes_;
   std::string node_name_;
 
   std::atomic<bool> shutting_down_{false};
+  std::mutex final_save_mutex_;  // SaveAtShutdown runs once
+  bool final_save_done_ = false;
   std::mutex stats_mutex_;  // the callback and publish figures below
   std::uint64_t callbacks_ = 0, frame_callbacks_ = 0;
   double callback_total_ms_ = 0.0, callback_max_ms_ = 0.0;
@@ -122,8 +130,10 @@ class MapperNodelet : public nodelet::Nodelet {
   std::unique_ptr<MapPublisher> map_publisher_;
   std::unique_ptr<DebugImagePublisher> debug_image_;
   std::unique_ptr<MapperDiagnostics> diagnostics_;
-  // Last: its thread calls into the publishers above, so it is stopped before they go.
+  // Its thread calls into the publishers above, so it is stopped before they go.
   std::unique_ptr<MappingWorker> worker_;
+  // Last: its thread reads worker_'s snapshots (and finishes it on SIGINT).
+  std::unique_ptr<MapSaver> saver_;
 };
 
 }  // namespace ipm_road_mapper

@@ -34,6 +34,7 @@ namespace ipm_road_mapper {
 struct MapSnapshot {
   std::shared_ptr<const VectorMap> map;  // with the nodelet's metadata; nullptr before start
   std::uint64_t map_version = 0;         // changes whenever the map may have changed
+  std::uint64_t resets = 0;              // ~resets before this map (its generation)
   double newest_frame_stamp = 0.0;       // of the newest used frame (s)
   std::string map_frame = "map";
   std::string refined_camera_frame;  // tf child of the refined extrinsic ("" before start)
@@ -115,6 +116,7 @@ class MappingWorker {
   std::string camera_frame_, extrinsic_status_, map_frame_;
   std::string refined_frame_;
   std::uint64_t map_version_ = 0, exported_version_ = 0;
+  std::uint64_t generation_ = 0;  // resets run
   bool status_dirty_ = true;
   double newest_frame_stamp_ = 0.0;
   std::shared_ptr<const VectorMap> exported_map_;
