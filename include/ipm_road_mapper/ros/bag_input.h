@@ -7,12 +7,24 @@
 #include <rosbag/bag.h>
 
 #include <Eigen/Geometry>
+#include <cstdint>
 #include <map>
 #include <string>
 #include <utility>
 #include <vector>
 
 namespace ipm_road_mapper {
+
+// What the file header of a bag says about its index (rosbag::Bag refuses to open a bag
+// without one: a bag cut short, or one whose recording was never closed).
+struct BagIndexCheck {
+  bool is_bag_v2 = false;      // starts with "#ROSBAG V2.0" and a readable file header
+  bool index_missing = false;  // index position 0 (not closed) or past the end (truncated)
+  std::string problem;         // one phrase, e.g. "it is truncated: ..."; empty when fine
+};
+
+// Reads only the bag's version line and file header record (a few hundred bytes).
+BagIndexCheck CheckBagIndex(const std::string& path);
 
 // Topic -> message type (e.g. "sensor_msgs/Image") of every connection in the bag.
 std::map<std::string, std::string> BagTopicTypes(const rosbag::Bag& bag);
@@ -24,7 +36,8 @@ std::string CheckBagTopics(const rosbag::Bag& bag,
 
 // The static transform T_parent_child (maps child-frame points into the parent frame) from
 // the bag's /tf_static, composing a chain of transforms when needed (tf2::BufferCore).
-// Empty on success, otherwise why it is not available.
+// Empty on success, otherwise why it is not available (also when a /tf_static message is in
+// an unreadable chunk).
 std::string LookupStaticTransform(const rosbag::Bag& bag, const std::string& parent_frame,
                                   const std::string& child_frame, Eigen::Isometry3d* T);
 
