@@ -20,7 +20,12 @@ void BagReadLossTracker::Lost(double bag_time_s, bool is_mask, const std::string
 std::string FormatLostSpans(const BagReadLoss& loss, double bag_begin_s) {
   if (loss.spans.empty()) return "none";
   std::string text;
-  for (const LostSpan& span : loss.spans) {
+  for (std::size_t k = 0; k < loss.spans.size(); ++k) {
+    if (k == kMaxSpansInText) {
+      text += " and " + std::to_string(loss.spans.size() - k) + " more";
+      break;
+    }
+    const LostSpan& span = loss.spans[k];
     char one[64];
     std::snprintf(one, sizeof(one), "%.2f-%.2f s", span.begin_s - bag_begin_s,
                   span.end_s - bag_begin_s);

@@ -119,7 +119,9 @@ TEST_F(BagInputTest, IndexCheckOfAnIntactBag) {
 TEST_F(BagInputTest, IndexCheckOfATruncatedBag) {
   const std::string cut = path_ + ".cut.bag";
   const std::size_t size = std::filesystem::file_size(path_);
-  CopyBag(path_, cut, size * 9 / 10, false);
+  // Half: before the index (this bag is small, its index a large part of it; a cut inside the
+  // index is not detected from the header, map_from_bag then suggests reindexing too).
+  CopyBag(path_, cut, size / 2, false);
   rosbag::Bag bag;
   EXPECT_THROW(bag.open(cut, rosbag::bagmode::Read), rosbag::BagException)
       << "rosbag's C++ API refuses a bag without its index (what map_from_bag must explain)";

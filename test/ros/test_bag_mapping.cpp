@@ -9,13 +9,12 @@
 
 #include <cstdint>
 #include <cstdio>
-#include <fstream>
-#include <iterator>
 #include <string>
 #include <vector>
 
 #include "ipm_road_mapper/ros/bag_mapping.h"
 #include "ipm_road_mapper/ros/msg_conversion.h"
+#include "ros/bag_test_damage.h"
 
 namespace ipm_road_mapper {
 namespace {
@@ -148,23 +147,6 @@ TEST_F(BagMappingTest, WorksWithoutCallbacks) {
   EXPECT_EQ(session.mapper()->counters().frames_used, static_cast<std::uint64_t>(kMasks - 2));
 }
 
-// Flips 32 bytes inside the compressed data of the `chunk`-th (0-based) LZ4 chunk of the bag.
-void CorruptChunk(const std::string& path, int chunk) {
-  std::fstream file(path, std::ios::in | std::ios::out | std::ios::binary);
-  const std::string bytes((std::istreambuf_iterator<char>(file)), std::istreambuf_iterator<char>());
-  std::size_t at = 0;
-  for (int k = 0; k <= chunk; ++k) {
-    at = bytes.find("compression=lz4", k == 0 ? 0 : at + 1);
-    ASSERT_NE(at, std::string::npos) << "the bag has fewer than " << chunk + 1 << " chunks";
-  }
-  file.clear();
-  for (std::size_t i = at + 200; i < at + 232; ++i) {
-    file.seekp(static_cast<std::streamoff>(i));
-    file.put(static_cast<char>(~bytes[i]));
-  }
-  ASSERT_TRUE(file.good());
-}
-
 // A bag of kFrames masks in small LZ4 chunks (one mask each, incompressible background
 // noise), with two of its chunks corrupted: a damaged bag.
 class DamagedBagMappingTest : public ::testing::Test {
@@ -181,7 +163,7 @@ class DamagedBagMappingTest : public ::testing::Test {
     {
       rosbag::Bag bag(path_, rosbag::bagmode::Write);
       bag.setCompression(rosbag::compression::LZ4);
-      bag.setChunkThreshold(4096);
+      bag.setChunkThreshold(8192);  // one chunk per frame (odometry, camera_info, mask)
       std::uint32_t noise = 12345;
       for (int k = 0; k < kFrames; ++k) {
         for (int i = 0; i < 5; ++i) {  // 50 Hz odometry, recorded before the mask
@@ -212,8 +194,8 @@ class DamagedBagMappingTest : public ::testing::Test {
         bag.write("/camera/instances", mask.header.stamp + ros::Duration(0.001), mask);
       }
     }
-    CorruptChunk(path_, 5);
-    CorruptChunk(path_, 12);
+    test::CorruptChunk(path_, 5);
+    test::CorruptChunk(path_, 12);
     bag_.open(path_, rosbag::bagmode::Read);  // the index at the end is intact
   }
   void TearDown() override {

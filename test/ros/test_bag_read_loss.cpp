@@ -61,5 +61,17 @@ TEST(BagReadLoss, OneSpanIsSingular) {
       << LostSpansLine(tracker.loss(), kBegin);
 }
 
+TEST(BagReadLoss, LongListsAreCutInTheText) {
+  BagReadLossTracker tracker;
+  for (int k = 0; k < 13; ++k) {
+    tracker.Lost(kBegin + k, false, "e");
+    tracker.Read();
+  }
+  const std::string text = FormatLostSpans(tracker.loss(), kBegin);
+  EXPECT_NE(text.find("9.00-9.00 s and 3 more"), std::string::npos) << text;
+  EXPECT_EQ(text.find("10.00-10.00 s"), std::string::npos) << text;
+  EXPECT_EQ(LostSpansToJson(tracker.loss(), kBegin)["spans"].size(), 13u);
+}
+
 }  // namespace
 }  // namespace ipm_road_mapper

@@ -43,7 +43,11 @@ class BagReadLossTracker {
   bool in_span_ = false;
 };
 
-// "12.35-14.80 s, 20.00-20.10 s" with times relative to `bag_begin_s`; "none" when empty.
+// Spans listed in the text (the stderr line, the summary); map.json has all of them.
+constexpr std::size_t kMaxSpansInText = 10;
+
+// "12.35-14.80 s, 20.00-20.10 s" with times relative to `bag_begin_s`, the first
+// kMaxSpansInText spans then " and N more"; "none" when empty.
 std::string FormatLostSpans(const BagReadLoss& loss, double bag_begin_s);
 
 // The one stderr line about the loss, e.g. "map_from_bag: lost 12.35-14.80 s of the bag (1
