@@ -5,6 +5,7 @@
 #include <rosbag/view.h>
 
 #include <exception>
+#include <map>
 #include <memory>
 #include <string>
 #include <utility>
@@ -96,11 +97,13 @@ void BagPrefetcher::Read(const rosbag::Bag& bag, const Topics& topics, bool reop
     // name of the last good chunk (rosbag updates the name only after a successful
     // decompression), so a later message of that chunk would deserialize garbage. The
     // reading then goes on in a freshly opened Bag, from the failed message's record time,
-    // skipping the messages of that time already handled.
+    // skipping the messages of that time already handled: per topic, as many as were
+    // handled (a new View may order messages of equal time differently across topics, but
+    // keeps the record order within one).
     std::unique_ptr<rosbag::Bag> reopened;
     ros::Time resume_time = ros::TIME_MIN;
     ros::Time last_time;
-    std::size_t handled_at_last_time = 0;  // messages handled with record time last_time
+    std::map<std::string, std::size_t> handled_at_last_time;  // per topic
     bool restart = true, after_error = reopen_first;
     while (restart) {
       restart = false;
@@ -110,14 +113,19 @@ void BagPrefetcher::Read(const rosbag::Bag& bag, const Topics& topics, bool reop
       }
       const rosbag::Bag& reading = reopened ? *reopened : bag;
       rosbag::View view(reading, rosbag::TopicQuery(names), resume_time);
-      std::size_t skip = reopened ? handled_at_last_time : 0;
+      std::map<std::string, std::size_t> skip;
+      if (reopened) skip = handled_at_last_time;
       for (const rosbag::MessageInstance& message : view) {
         const ros::Time time = message.getTime();
-        if (skip > 0 && time == resume_time) {
-          --skip;
-          continue;
+        if (time == resume_time) {
+          std::size_t& to_skip = skip[message.getTopic()];
+          if (to_skip > 0) {
+            --to_skip;
+            continue;
+          }
         }
-        handled_at_last_time = time == last_time ? handled_at_last_time + 1 : 1;
+        if (time != last_time) handled_at_last_time.clear();
+        ++handled_at_last_time[message.getTopic()];
         last_time = time;
         Item item = Deserialize(message, topics);
         const bool failed = !item.read_error.empty();

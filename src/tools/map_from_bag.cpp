@@ -26,6 +26,7 @@
 // opened by rosbag's C++ API: one line suggests `rosbag reindex <bag>`, exit 2. Exit status: 0 done
 // (or --help); 2 bad input (bad command line, missing bag, bad config, missing topic, no extrinsic,
 // ...) with one error line on stderr; 1 an output could not be written.
+#include <console_bridge/console.h>
 #include <ros/package.h>
 #include <rosbag/view.h>
 #include <sensor_msgs/Image.h>
@@ -258,9 +259,25 @@ void WriteOutputs(const std::string& dir, const VectorMap& map,
   if (!out) throw std::runtime_error(dir + "/summary.txt: cannot write");
 }
 
+// Silences console_bridge (which cpp_common's header parser logs to) while it lives: a
+// damaged index must end in map_from_bag's one error line only.
+class QuietConsoleBridge {
+ public:
+  QuietConsoleBridge() : level_(console_bridge::getLogLevel()) {
+    console_bridge::setLogLevel(console_bridge::CONSOLE_BRIDGE_LOG_NONE);
+  }
+  ~QuietConsoleBridge() { console_bridge::setLogLevel(level_); }
+  QuietConsoleBridge(const QuietConsoleBridge&) = delete;
+  QuietConsoleBridge& operator=(const QuietConsoleBridge&) = delete;
+
+ private:
+  console_bridge::LogLevel level_;
+};
+
 // Opens the bag for reading; a bag without its index gets the `rosbag reindex` suggestion.
 void OpenBag(const std::string& path, rosbag::Bag* bag) {
   try {
+    const QuietConsoleBridge quiet;
     bag->open(path, rosbag::bagmode::Read);
     return;
   } catch (const rosbag::BagException& e) {

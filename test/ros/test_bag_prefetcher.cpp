@@ -8,6 +8,7 @@
 #include <stdlib.h>
 #include <unistd.h>
 
+#include <cmath>
 #include <cstdint>
 #include <cstdio>
 #include <string>
@@ -131,12 +132,13 @@ TEST_F(BagPrefetcherTest, StopsCleanlyWhenTheConsumerLeavesEarly) {
 }
 
 // A bag whose first chunk holds all the odometry (written first) and each later chunk one
-// mask of incompressible bytes, recorded between the odometry messages: read in time order,
-// the odometry chunk is decompressed again after every mask chunk. Mask 6's chunk is corrupt.
+// mask of incompressible bytes and a camera_info of the same record time, recorded between the
+// odometry messages: read in time order, the odometry chunk is decompressed again after every
+// mask chunk. One mask chunk (the 7th chunk of the file) is corrupt.
 class DamagedBagPrefetcherTest : public ::testing::Test {
  protected:
   static constexpr int kFrames = 12;
-  static constexpr int kCorruptMask = 6;
+  static constexpr int kCorruptChunk = 6;
 
   void SetUp() override {
     ros::Time::init();
@@ -167,10 +169,14 @@ class DamagedBagPrefetcherTest : public ::testing::Test {
           noise = noise * 1664525u + 1013904223u;
           mask.data.push_back(static_cast<std::uint8_t>(noise >> 24));
         }
+        sensor_msgs::CameraInfo info;
+        info.header.stamp = mask.header.stamp;
+        info.width = k;
+        bag.write("/camera/camera_info", mask.header.stamp, info);
         bag.write("/camera/instances", mask.header.stamp, mask);
       }
     }
-    test::CorruptChunk(path_, kCorruptMask);  // chunk 0: the odometry and mask 0; k: mask k
+    test::CorruptChunk(path_, kCorruptChunk);
     bag_.open(path_, rosbag::bagmode::Read);
   }
   void TearDown() override {
@@ -183,20 +189,29 @@ class DamagedBagPrefetcherTest : public ::testing::Test {
 };
 
 TEST_F(DamagedBagPrefetcherTest, GoesOnAfterAnUnreadableChunkWithoutGarbage) {
-  BagPrefetcher prefetcher(bag_, {"/camera/instances", "/odom", ""}, 3);
+  BagPrefetcher prefetcher(bag_, {"/camera/instances", "/odom", "/camera/camera_info"}, 3);
   BagPrefetcher::Item item;
-  int masks = 0, odometry = 0, unreadable = 0;
+  int masks = 0, odometry = 0, unreadable_masks = 0, unreadable_infos = 0;
+  std::vector<double> unreadable_times;
+  std::vector<int> camera_info_frames;
   while (prefetcher.Next(&item)) {
     if (!item.read_error.empty()) {
-      ++unreadable;
-      EXPECT_EQ(item.kind, BagPrefetcher::Kind::kMask);
-      EXPECT_FALSE(item.mask);
-      EXPECT_NEAR(item.bag_time_s, 1000.0 + 0.1 * kCorruptMask + 0.05, 1e-6);
+      // Each message of the corrupt chunk once: resuming at their record time skips, per
+      // topic, what was handled, whatever order the new View gives messages of equal time.
+      unreadable_masks += item.kind == BagPrefetcher::Kind::kMask;
+      unreadable_infos += item.kind == BagPrefetcher::Kind::kCameraInfo;
+      EXPECT_FALSE(item.mask || item.camera_info);
+      unreadable_times.push_back(item.bag_time_s);
       continue;
     }
     if (item.kind == BagPrefetcher::Kind::kMask) {
       ASSERT_TRUE(item.mask);
       ++masks;
+      continue;
+    }
+    if (item.kind == BagPrefetcher::Kind::kCameraInfo) {
+      ASSERT_TRUE(item.camera_info);
+      camera_info_frames.push_back(static_cast<int>(item.camera_info->width));
       continue;
     }
     // The odometry after the corrupt chunk comes from the intact first chunk: the exact
@@ -206,8 +221,19 @@ TEST_F(DamagedBagPrefetcherTest, GoesOnAfterAnUnreadableChunkWithoutGarbage) {
     EXPECT_NEAR(item.bag_time_s, 1000.0 + 0.1 * odometry, 1e-6);
     ++odometry;
   }
-  EXPECT_EQ(unreadable, 1);
+  EXPECT_EQ(unreadable_masks, 1);
+  EXPECT_EQ(unreadable_infos, 1);
   EXPECT_EQ(masks, kFrames - 1);
+  // The lost frame is one frame of a mask chunk; every other camera_info once, in order.
+  ASSERT_EQ(unreadable_times.size(), 2u);
+  EXPECT_DOUBLE_EQ(unreadable_times[0], unreadable_times[1]);
+  const int lost_frame = static_cast<int>(std::lround((unreadable_times[0] - 1000.05) / 0.1));
+  EXPECT_GT(lost_frame, 0);
+  std::vector<int> expected_frames;
+  for (int k = 0; k < kFrames; ++k) {
+    if (k != lost_frame) expected_frames.push_back(k);
+  }
+  EXPECT_EQ(camera_info_frames, expected_frames);
   EXPECT_EQ(odometry, kFrames) << "every odometry message exactly once (none repeated on resume)";
 }
 

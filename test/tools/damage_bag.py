@@ -9,8 +9,12 @@ usage: damage_bag.py truncate <in.bag> <out.bag> --fraction F
          32 bytes flipped in the middle of the data of each chunk K (0-based, in file order;
          the chunk headers and the index stay intact); prints one line per chunk:
          "chunk K: <start>-<end> s" (record times relative to the bag's start)
+       damage_bag.py flip <in.bag> <out.bag> --seed S --count N
+         N random bytes after the file header inverted (chunks, their headers or the index):
+         a fuzz case
 """
 import argparse
+import random
 import shutil
 import struct
 
@@ -50,6 +54,14 @@ def corrupt(args):
                   f"{chunk.end_time.to_sec() - start:.2f} s")
 
 
+def flip(args):
+    data = bytearray(open(args.input, "rb").read())
+    rng = random.Random(args.seed)
+    for _ in range(args.count):
+        data[rng.randrange(13 + 4096, len(data))] ^= 0xFF
+    open(args.output, "wb").write(bytes(data))
+
+
 def main():
     parser = argparse.ArgumentParser()
     sub = parser.add_subparsers(dest="command", required=True)
@@ -64,8 +76,13 @@ def main():
     p.add_argument("input")
     p.add_argument("output")
     p.add_argument("--chunks", type=int, nargs="+", required=True)
+    p = sub.add_parser("flip")
+    p.add_argument("input")
+    p.add_argument("output")
+    p.add_argument("--seed", type=int, required=True)
+    p.add_argument("--count", type=int, required=True)
     args = parser.parse_args()
-    {"truncate": truncate, "unclose": unclose, "corrupt": corrupt}[args.command](args)
+    {"truncate": truncate, "unclose": unclose, "corrupt": corrupt, "flip": flip}[args.command](args)
 
 
 if __name__ == "__main__":

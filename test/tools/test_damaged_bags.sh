@@ -5,7 +5,10 @@
 #    maps >= 80 % of the frames;
 #  - never closed (index position 0): the same suggestion, exit 2;
 #  - two corrupt chunks (bytes flipped in their lz4 data): exit 0, the frames of the other
-#    chunks mapped, the lost spans on stderr, in summary.txt and in map.json metadata.
+#    chunks mapped, the lost spans (those of the chunks) on stderr, in summary.txt and in
+#    map.json metadata;
+#  - random bytes flipped anywhere after the file header (8 seeds): exit 0 with every mask
+#    accounted for, or exit 2 with one line.
 # No run ends with a signal. Run by ctest in the devel space's environment.
 set -eo pipefail
 export PATH="/usr/bin:/bin:$PATH"
@@ -70,8 +73,11 @@ run_mapper "$work/corrupt.bag" "$work/corrupt"
 if [ "$rc" -ne 0 ]; then
   fail "corrupt bag: exit $rc, expected 0: $(tail -3 "$work/corrupt.stderr")"
 else
+  # The spans of the corrupted chunks, as damage_bag.py printed them: "0.93-0.93 s, 1.73-1.73 s".
+  spans=$(sed -n 's/^chunk [0-9]*: \(.*\)$/\1/p' "$work/corrupted_chunks.txt" | paste -sd, | sed 's/,/, /g')
+  [ "$spans" = "0.93-0.93 s, 1.73-1.73 s" ] || fail "the test drive changed: corrupted chunks $spans"
   lost_line=$(grep "^map_from_bag: lost " "$work/corrupt.stderr" || true)
-  if echo "$lost_line" | grep -q "lost 0.93-0.93 s, 1.73-1.73 s of the bag (2 unreadable spans"; then
+  if echo "$lost_line" | grep -qF "lost $spans of the bag (2 unreadable spans"; then
     pass "lost spans on stderr: $lost_line"
   else
     fail "no (or a wrong) lost line on stderr: '$lost_line'"; cat "$work/corrupt.stderr"
@@ -102,7 +108,31 @@ print(f"ok: map.json metadata lost: {lost['messages']} messages, spans {spans}; 
 EOF2
 fi
 
-# 4. The intact bag: nothing lost, and said so.
+# 4. Fuzz: random bytes inverted (chunk data, chunk headers, the index). With the extrinsic
+# from the config, so that a lost /tf_static does not end every run early.
+config="$work/extrinsic.yaml"
+{ echo "base: $repo/config/mapper.yaml"; echo "backend: {enabled: false}"
+  echo "input: {extrinsic: {xyz: [1.0, 0.0, 1.5], rpy_deg: [-95.0, 0.0, -90.0]}}"; } >"$config"
+outcomes=""
+for seed in 1 2 3 4 5 6 7 8; do
+  damage flip "$work/drive.bag" "$work/fuzz.bag" --seed "$seed" --count 4
+  rc=0
+  rosrun ipm_road_mapper map_from_bag --bag "$work/fuzz.bag" --config "$config" --out "$work/fuzz" \
+    >/dev/null 2>"$work/fuzz.stderr" || rc=$?
+  if [ "$rc" -eq 0 ]; then
+    grep -q "^frames read: 25$" "$work/fuzz/summary.txt" || fail "fuzz seed $seed: frames read is not 25"
+  elif [ "$rc" -eq 2 ]; then
+    [ "$(wc -l <"$work/fuzz.stderr")" -eq 1 ] && grep -q "^map_from_bag: error: " "$work/fuzz.stderr" \
+      || { fail "fuzz seed $seed: exit 2 without exactly one error line:"; cat "$work/fuzz.stderr"; }
+  else
+    fail "fuzz seed $seed: exit $rc (a signal when > 128): $(tail -2 "$work/fuzz.stderr")"
+  fi
+  outcomes="$outcomes $rc"
+  rm -rf "$work/fuzz"
+done
+pass "fuzz: exit codes$outcomes (0: mapped, every mask accounted for; 2: one line)"
+
+# 5. The intact bag: nothing lost, and said so.
 run_mapper "$work/drive.bag" "$work/intact"
 if [ "$rc" -eq 0 ] && ! grep -q "^map_from_bag: lost" "$work/intact.stderr" &&
    grep -q "^lost: 0 messages (0 masks) in 0 unreadable spans: none$" "$work/intact/summary.txt" &&
