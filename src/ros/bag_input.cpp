@@ -1,6 +1,9 @@
 #include "ipm_road_mapper/ros/bag_input.h"
 
+#include <console_bridge/console.h>
+#include <rosbag/exceptions.h>
 #include <rosbag/view.h>
+#include <sensor_msgs/Image.h>
 #include <tf2/buffer_core.h>
 #include <tf2/exceptions.h>
 #include <tf2_msgs/TFMessage.h>
@@ -43,6 +46,21 @@ bool ParseRecordHeader(const std::string& header, std::map<std::string, std::str
   return at == header.size();
 }
 
+// Silences console_bridge (which cpp_common's header parser logs to) while it lives: a
+// damaged index must end in map_from_bag's one error line only.
+class QuietConsoleBridge {
+ public:
+  QuietConsoleBridge() : level_(console_bridge::getLogLevel()) {
+    console_bridge::setLogLevel(console_bridge::CONSOLE_BRIDGE_LOG_NONE);
+  }
+  ~QuietConsoleBridge() { console_bridge::setLogLevel(level_); }
+  QuietConsoleBridge(const QuietConsoleBridge&) = delete;
+  QuietConsoleBridge& operator=(const QuietConsoleBridge&) = delete;
+
+ private:
+  console_bridge::LogLevel level_;
+};
+
 }  // namespace
 
 BagIndexCheck CheckBagIndex(const std::string& path) {
@@ -76,6 +94,47 @@ BagIndexCheck CheckBagIndex(const std::string& path) {
                     " of a " + std::to_string(file_bytes) + "-byte file)";
   }
   return check;
+}
+
+std::string OpenBagForReading(const std::string& path, rosbag::Bag* bag) {
+  try {
+    const QuietConsoleBridge quiet;
+    bag->open(path, rosbag::bagmode::Read);
+    return "";
+  } catch (const rosbag::BagException& e) {
+    const BagIndexCheck check = CheckBagIndex(path);
+    const std::string reindex = "run `rosbag reindex " + path +
+                                "` (it keeps the original as *.orig.bag) and map the "
+                                "reindexed bag";
+    if (check.index_missing) {
+      return path + ": cannot read bag: " + check.problem +
+             ", and rosbag's C++ API reads only indexed bags; " + reindex;
+    }
+    if (check.is_bag_v2) {
+      return path + ": cannot read bag: " + e.what() + " (its index may be damaged: " + reindex +
+             ")";
+    }
+    return path + ": cannot read bag: " + e.what() + " (" + check.problem + ")";
+  }
+}
+
+std::string FirstReadableMaskFrame(rosbag::Bag* bag, const std::string& mask_topic) {
+  for (std::size_t unreadable = 0;; ++unreadable) {
+    rosbag::View masks(*bag, rosbag::TopicQuery(mask_topic));
+    if (masks.size() <= unreadable) return "";
+    auto message = masks.begin();
+    for (std::size_t k = 0; k < unreadable; ++k) ++message;
+    try {
+      const auto mask = message->instantiate<sensor_msgs::Image>();
+      return mask ? mask->header.frame_id : "";
+    } catch (const rosbag::BagException&) {
+      const std::string path = bag->getFileName();
+      bag->close();
+      bag->open(path, rosbag::bagmode::Read);
+    } catch (const std::exception&) {
+      return "";  // not an Image: no camera frame (the extrinsic error says so)
+    }
+  }
 }
 
 std::map<std::string, std::string> BagTopicTypes(const rosbag::Bag& bag) {

@@ -26,10 +26,8 @@
 // opened by rosbag's C++ API: one line suggests `rosbag reindex <bag>`, exit 2. Exit status: 0 done
 // (or --help); 2 bad input (bad command line, missing bag, bad config, missing topic, no extrinsic,
 // ...) with one error line on stderr; 1 an output could not be written.
-#include <console_bridge/console.h>
 #include <ros/package.h>
 #include <rosbag/view.h>
-#include <sensor_msgs/Image.h>
 
 #include <chrono>
 #include <cmath>
@@ -115,27 +113,6 @@ MapperConfig LoadConfig(const std::string& path) {
   }
 }
 
-// The header.frame_id of the first mask that can be read. After a read error (a corrupt
-// chunk) the bag is reopened, as rosbag's chunk cache may then be wrong (bag_prefetcher.cpp).
-std::string FirstMaskFrame(rosbag::Bag* bag, const std::string& mask_topic) {
-  for (std::size_t unreadable = 0;; ++unreadable) {
-    rosbag::View masks(*bag, rosbag::TopicQuery(mask_topic));
-    if (masks.size() <= unreadable) return "";
-    auto message = masks.begin();
-    for (std::size_t k = 0; k < unreadable; ++k) ++message;
-    try {
-      const auto mask = message->instantiate<sensor_msgs::Image>();
-      return mask ? mask->header.frame_id : "";
-    } catch (const rosbag::BagException&) {
-      const std::string path = bag->getFileName();
-      bag->close();
-      bag->open(path, rosbag::bagmode::Read);
-    } catch (const std::exception&) {
-      return "";  // not an Image: no camera frame (the extrinsic error says so)
-    }
-  }
-}
-
 // The rough extrinsic and where it came from (ChooseExtrinsic, as the nodelet decides it).
 Eigen::Isometry3d FindExtrinsic(rosbag::Bag* bag_ptr, const InputOptions& input,
                                 const std::string& mask_topic, std::string* source) {
@@ -145,7 +122,7 @@ Eigen::Isometry3d FindExtrinsic(rosbag::Bag* bag_ptr, const InputOptions& input,
     if (rosbag::View(bag, rosbag::TopicQuery(mask_topic)).size() == 0) {
       throw InputError("topic " + mask_topic + " has no message");
     }
-    camera_frame = FirstMaskFrame(bag_ptr, mask_topic);
+    camera_frame = FirstReadableMaskFrame(bag_ptr, mask_topic);
   }
   const TransformLookup lookup = [&bag](const std::string& parent, const std::string& child,
                                         Eigen::Isometry3d* T) {
@@ -259,44 +236,6 @@ void WriteOutputs(const std::string& dir, const VectorMap& map,
   if (!out) throw std::runtime_error(dir + "/summary.txt: cannot write");
 }
 
-// Silences console_bridge (which cpp_common's header parser logs to) while it lives: a
-// damaged index must end in map_from_bag's one error line only.
-class QuietConsoleBridge {
- public:
-  QuietConsoleBridge() : level_(console_bridge::getLogLevel()) {
-    console_bridge::setLogLevel(console_bridge::CONSOLE_BRIDGE_LOG_NONE);
-  }
-  ~QuietConsoleBridge() { console_bridge::setLogLevel(level_); }
-  QuietConsoleBridge(const QuietConsoleBridge&) = delete;
-  QuietConsoleBridge& operator=(const QuietConsoleBridge&) = delete;
-
- private:
-  console_bridge::LogLevel level_;
-};
-
-// Opens the bag for reading; a bag without its index gets the `rosbag reindex` suggestion.
-void OpenBag(const std::string& path, rosbag::Bag* bag) {
-  try {
-    const QuietConsoleBridge quiet;
-    bag->open(path, rosbag::bagmode::Read);
-    return;
-  } catch (const rosbag::BagException& e) {
-    const BagIndexCheck check = CheckBagIndex(path);
-    const std::string reindex = "run `rosbag reindex " + path +
-                                "` (it keeps the original as *.orig.bag) and map the "
-                                "reindexed bag";
-    if (check.index_missing) {
-      throw InputError(path + ": cannot read bag: " + check.problem +
-                       ", and rosbag's C++ API reads only indexed bags; " + reindex);
-    }
-    if (check.is_bag_v2) {
-      throw InputError(path + ": cannot read bag: " + e.what() +
-                       " (its index may be damaged: " + reindex + ")");
-    }
-    throw InputError(path + ": cannot read bag: " + e.what() + " (" + check.problem + ")");
-  }
-}
-
 int Run(int argc, char** argv) {
   Arguments args;
   if (const std::optional<int> exit_code = ParseArguments(argc, argv, &args)) return *exit_code;
@@ -315,7 +254,9 @@ int Run(int argc, char** argv) {
   }
   if (!fs::is_regular_file(args.bag)) throw InputError(args.bag + ": no such bag file");
   rosbag::Bag bag;
-  OpenBag(args.bag, &bag);
+  if (const std::string error = OpenBagForReading(args.bag, &bag); !error.empty()) {
+    throw InputError(error);
+  }
   const InputOptions& input = options.input;
   const RosOptions& topics = config.ros;  // the bag's topic names and sync, as the nodelet's
   const std::string topic_error =

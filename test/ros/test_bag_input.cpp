@@ -114,6 +114,9 @@ TEST_F(BagInputTest, IndexCheckOfAnIntactBag) {
   EXPECT_TRUE(check.is_bag_v2);
   EXPECT_FALSE(check.index_missing);
   EXPECT_EQ(check.problem, "");
+  rosbag::Bag bag;
+  EXPECT_EQ(OpenBagForReading(path_, &bag), "");
+  EXPECT_TRUE(bag.isOpen());
 }
 
 TEST_F(BagInputTest, IndexCheckOfATruncatedBag) {
@@ -129,6 +132,14 @@ TEST_F(BagInputTest, IndexCheckOfATruncatedBag) {
   EXPECT_TRUE(check.is_bag_v2);
   EXPECT_TRUE(check.index_missing);
   EXPECT_NE(check.problem.find("truncated"), std::string::npos) << check.problem;
+  const std::string error = OpenBagForReading(cut, &bag);
+  EXPECT_NE(error.find("truncated"), std::string::npos) << error;
+  EXPECT_NE(error.find("run `rosbag reindex " + cut + "`"), std::string::npos) << error;
+  EXPECT_EQ(error.find('\n'), std::string::npos) << "one line";
+  // Cut inside the index: not visible in the header, still the suggestion.
+  CopyBag(path_, cut, size - 10, false);
+  const std::string index_error = OpenBagForReading(cut, &bag);
+  EXPECT_NE(index_error.find("rosbag reindex"), std::string::npos) << index_error;
   std::remove(cut.c_str());
 }
 
@@ -148,6 +159,10 @@ TEST_F(BagInputTest, IndexCheckOfNotABag) {
   EXPECT_FALSE(CheckBagIndex(garbage).is_bag_v2);
   EXPECT_FALSE(CheckBagIndex(garbage).index_missing);
   EXPECT_FALSE(CheckBagIndex(garbage).problem.empty());
+  rosbag::Bag bag;
+  const std::string error = OpenBagForReading(garbage, &bag);
+  EXPECT_NE(error.find("not a ROS bag"), std::string::npos) << error;
+  EXPECT_EQ(error.find("reindex"), std::string::npos) << error;
   EXPECT_FALSE(CheckBagIndex(path_ + ".missing").is_bag_v2);
   std::remove(garbage.c_str());
   // A version line and then nothing: a damaged header, not a crash.

@@ -1,7 +1,7 @@
-// Reading the mapper's input from a bag file with the rosbag C++ API (no roscore): topic
-// checks and the camera extrinsic from /tf_static (camera_info <-> mask pairing:
-// bag_camera_info.h). Used by the offline runner (map_from_bag); errors are one line, never
-// exceptions.
+// Reading the mapper's input from a bag file with the rosbag C++ API (no roscore): opening
+// (with what a bag without its index needs), topic checks, the first mask's frame and the
+// camera extrinsic from /tf_static (camera_info <-> mask pairing: bag_camera_info.h). Used by the
+// offline runner (map_from_bag); errors are one line, never exceptions.
 #pragma once
 
 #include <rosbag/bag.h>
@@ -25,6 +25,17 @@ struct BagIndexCheck {
 
 // Reads only the bag's version line and file header record (a few hundred bytes).
 BagIndexCheck CheckBagIndex(const std::string& path);
+
+// Opens the bag at `path` for reading into *bag. Empty on success, otherwise one line
+// "<path>: cannot read bag: ..." that, for a bag without its index (CheckBagIndex) or with a
+// damaged one, says so and suggests `rosbag reindex <path>`. console_bridge (cpp_common's
+// header parser logs a damaged record to it) is silenced while the bag is opened.
+std::string OpenBagForReading(const std::string& path, rosbag::Bag* bag);
+
+// The header.frame_id of the first mask on `mask_topic` that can be read ("" when none can,
+// or it is not a sensor_msgs/Image). After a read error (a corrupt chunk) the bag is reopened,
+// as rosbag's chunk cache may then be wrong (bag_prefetcher.cpp).
+std::string FirstReadableMaskFrame(rosbag::Bag* bag, const std::string& mask_topic);
 
 // Topic -> message type (e.g. "sensor_msgs/Image") of every connection in the bag.
 std::map<std::string, std::string> BagTopicTypes(const rosbag::Bag& bag);
