@@ -9,6 +9,9 @@ usage: damage_bag.py truncate <in.bag> <out.bag> --fraction F
          32 bytes flipped in the middle of the data of each chunk K (0-based, in file order;
          the chunk headers and the index stay intact); prints one line per chunk:
          "chunk K: <start>-<end> s" (record times relative to the bag's start)
+       damage_bag.py recompress <in.bag> <out.bag> --compression none|bz2|lz4
+         the same messages, record times and order, in chunks of that compression (not a
+         damage: the bag to damage next)
        damage_bag.py flip <in.bag> <out.bag> --seed S --count N
          N random bytes after the file header inverted (chunks, their headers or the index):
          a fuzz case
@@ -54,6 +57,12 @@ def corrupt(args):
                   f"{chunk.end_time.to_sec() - start:.2f} s")
 
 
+def recompress(args):
+    with rosbag.Bag(args.input) as bag, rosbag.Bag(args.output, "w", compression=args.compression) as out:
+        for topic, raw, time in bag.read_messages(raw=True):
+            out.write(topic, raw, time, raw=True)
+
+
 def flip(args):
     data = bytearray(open(args.input, "rb").read())
     rng = random.Random(args.seed)
@@ -76,13 +85,18 @@ def main():
     p.add_argument("input")
     p.add_argument("output")
     p.add_argument("--chunks", type=int, nargs="+", required=True)
+    p = sub.add_parser("recompress")
+    p.add_argument("input")
+    p.add_argument("output")
+    p.add_argument("--compression", choices=["none", "bz2", "lz4"], required=True)
     p = sub.add_parser("flip")
     p.add_argument("input")
     p.add_argument("output")
     p.add_argument("--seed", type=int, required=True)
     p.add_argument("--count", type=int, required=True)
     args = parser.parse_args()
-    {"truncate": truncate, "unclose": unclose, "corrupt": corrupt, "flip": flip}[args.command](args)
+    {"truncate": truncate, "unclose": unclose, "corrupt": corrupt, "recompress": recompress,
+     "flip": flip}[args.command](args)
 
 
 if __name__ == "__main__":

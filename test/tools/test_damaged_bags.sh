@@ -7,6 +7,8 @@
 #  - two corrupt chunks (bytes flipped in their lz4 data): exit 0, the frames of the other
 #    chunks mapped, the lost spans (those of the chunks) on stderr, in summary.txt and in
 #    map.json metadata;
+#  - the same with bz2 chunks (the drive rewritten: odometry now in every chunk), the lost
+#    spans those of the two chunks;
 #  - random bytes flipped anywhere after the file header (8 seeds): exit 0 with every mask
 #    accounted for, or exit 2 with one line.
 # No run ends with a signal. Run by ctest in the devel space's environment.
@@ -106,6 +108,19 @@ assert len(m["markings"]) >= 1, "no marking mapped"
 print(f"ok: map.json metadata lost: {lost['messages']} messages, spans {spans}; "
       f"{len(m['markings'])} markings mapped")
 EOF2
+fi
+
+# 3b. bz2 chunks: the lost spans are the corrupted chunks' spans.
+damage recompress "$work/drive.bag" "$work/drive_bz2.bag" --compression bz2
+damage corrupt "$work/drive_bz2.bag" "$work/corrupt_bz2.bag" --chunks 8 16 >"$work/corrupted_bz2.txt"
+spans=$(sed -n 's/^chunk [0-9]*: \(.*\)$/\1/p' "$work/corrupted_bz2.txt" | paste -sd, | sed 's/,/, /g')
+run_mapper "$work/corrupt_bz2.bag" "$work/corrupt_bz2"
+used=$(frames used "$work/corrupt_bz2/summary.txt" 2>/dev/null || true)
+if [ "$rc" -eq 0 ] && grep -qF "map_from_bag: lost $spans of the bag (2 unreadable spans" \
+     "$work/corrupt_bz2.stderr" && [ -n "$used" ] && [ "$used" -ge 20 ]; then
+  pass "bz2 chunks: exit 0, lost $spans (the corrupted chunks), $used frames used"
+else
+  fail "bz2 chunks (exit $rc, chunks $spans, $used used):"; grep -v frames/s "$work/corrupt_bz2.stderr"
 fi
 
 # 4. Fuzz: random bytes inverted (chunk data, chunk headers, the index). With the extrinsic
