@@ -1,5 +1,6 @@
 #include "ipm_road_mapper/ros/bag_camera_info.h"
 
+#include <ros/serialization.h>
 #include <rosbag/view.h>
 
 #include <algorithm>
@@ -25,7 +26,8 @@ CameraInfoTable::CameraInfoTable(double approximate_tolerance_s)
     : approximate_tolerance_s_(approximate_tolerance_s) {}
 
 double CameraInfoTable::ToleranceFromFirstMessages(const rosbag::Bag& bag, const std::string& topic,
-                                                   std::size_t sample) {
+                                                   std::size_t sample, bool* read_failed) {
+  if (read_failed) *read_failed = false;
   std::vector<ros::Time> stamps;
   rosbag::View view(bag, rosbag::TopicQuery(topic));
   for (const rosbag::MessageInstance& message : view) {
@@ -33,8 +35,17 @@ double CameraInfoTable::ToleranceFromFirstMessages(const rosbag::Bag& bag, const
     if (message.getDataType() != ros::message_traits::DataType<sensor_msgs::CameraInfo>::value()) {
       continue;
     }
-    const auto info = message.instantiate<sensor_msgs::CameraInfo>();
-    if (info) stamps.push_back(info->header.stamp);
+    try {
+      const auto info = message.instantiate<sensor_msgs::CameraInfo>();
+      if (info) stamps.push_back(info->header.stamp);
+    } catch (const ros::serialization::StreamOverrunException&) {
+      // Not a CameraInfo: the period comes from the others.
+    } catch (const std::exception&) {
+      // A corrupt chunk: the bag's chunk cache may now be wrong (bag_prefetcher.cpp), so no
+      // further message is read from it.
+      if (read_failed) *read_failed = true;
+      break;
+    }
   }
   std::sort(stamps.begin(), stamps.end());
   std::vector<double> periods;

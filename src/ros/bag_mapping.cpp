@@ -56,6 +56,19 @@ class BagMapping {
     paired->clear();
   }
 
+  // A message of the mapper's topics that could not be read from the bag (a corrupt chunk);
+  // a mask is a frame lost and counted as such.
+  void AddUnreadable(const BagPrefetcher::Item& item) {
+    const bool is_mask = item.kind == BagPrefetcher::Kind::kMask;
+    loss_.Lost(item.bag_time_s, is_mask, item.read_error);
+    if (!is_mask) return;
+    session_->CountSkipped("unreadable_chunk: " + item.read_error, &update_);
+    FrameDone(std::numeric_limits<double>::quiet_NaN());
+  }
+
+  // A message that was read: a span of unreadable ones ends.
+  void MessageRead() { loss_.Read(); }
+
   // A mask message that did not deserialize.
   void AddBadMask() {
     session_->CountSkipped("bad_mask_message: not a sensor_msgs/Image", &update_);
@@ -68,6 +81,7 @@ class BagMapping {
   }
 
   std::size_t frames_read() const { return frames_read_; }
+  const BagReadLoss& lost() const { return loss_.loss(); }
 
  private:
   void FrameDone(double stamp) {
@@ -89,23 +103,31 @@ class BagMapping {
   MappingSession* session_;
   const BagMappingCallbacks& callbacks_;
   SessionUpdate update_;
+  BagReadLossTracker loss_;
   std::size_t frames_read_ = 0;
   bool first_frame_reported_ = false;
 };
 
 }  // namespace
 
-std::size_t MapBag(const rosbag::Bag& bag, const RosOptions& topics, MappingSession* session,
-                   const BagMappingCallbacks& callbacks) {
-  CameraInfoPairing pairing(
-      CameraInfoTable(CameraInfoTable::ToleranceFromFirstMessages(bag, topics.camera_info_topic)),
-      topics.sync == "exact");
+BagMappingResult MapBag(const rosbag::Bag& bag, const RosOptions& topics, MappingSession* session,
+                        const BagMappingCallbacks& callbacks) {
+  bool read_failed = false;  // then the prefetcher reads from a freshly opened bag
+  CameraInfoPairing pairing(CameraInfoTable(CameraInfoTable::ToleranceFromFirstMessages(
+                                bag, topics.camera_info_topic, 20, &read_failed)),
+                            topics.sync == "exact");
   BagMapping mapping(session, callbacks);
   std::vector<PairedMask> paired;
   {
-    BagPrefetcher prefetcher(bag, {topics.mask_topic, topics.odom_topic, topics.camera_info_topic});
+    BagPrefetcher prefetcher(bag, {topics.mask_topic, topics.odom_topic, topics.camera_info_topic},
+                             16, read_failed);
     BagPrefetcher::Item message;
     while (prefetcher.Next(&message)) {
+      if (!message.read_error.empty()) {
+        mapping.AddUnreadable(message);
+        continue;
+      }
+      mapping.MessageRead();
       switch (message.kind) {
         case BagPrefetcher::Kind::kOdometry:
           mapping.AddOdometry(message.odometry);
@@ -128,7 +150,7 @@ std::size_t MapBag(const rosbag::Bag& bag, const RosOptions& topics, MappingSess
   pairing.Flush(&paired);
   mapping.AddPaired(&paired);
   mapping.Finish();
-  return mapping.frames_read();
+  return {mapping.frames_read(), mapping.lost()};
 }
 
 }  // namespace ipm_road_mapper

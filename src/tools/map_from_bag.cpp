@@ -20,12 +20,14 @@
 // is composed). Defaults: --config and --classes are config/mapper.yaml and
 // config/classes.yaml of the package, found by rospack (ROS_PACKAGE_PATH), else under
 // $IRM_SOURCE_DIR, else in the install space next to the executable
-// (../../share/ipm_road_mapper). Exit status: 0 done (or --help); 2 bad input (bad command
-// line, missing bag, bad config, missing topic, no extrinsic, ...) with one error line on
-// stderr; 1 an output could not be written.
+// (../../share/ipm_road_mapper). A damaged bag maps what can be read: a message of an
+// unreadable chunk is skipped and counted, and the lost time spans are printed and written to
+// the summary and map.json; a bag without its index (cut short, or never closed) cannot be
+// opened by rosbag's C++ API: one line suggests `rosbag reindex <bag>`, exit 2. Exit status: 0 done
+// (or --help); 2 bad input (bad command line, missing bag, bad config, missing topic, no extrinsic,
+// ...) with one error line on stderr; 1 an output could not be written.
 #include <ros/package.h>
 #include <rosbag/view.h>
-#include <sensor_msgs/Image.h>
 
 #include <chrono>
 #include <cmath>
@@ -38,6 +40,7 @@
 #include <sstream>
 #include <stdexcept>
 #include <string>
+#include <utility>
 
 #include "ipm_road_mapper/core/geometry/rigid_transform.h"
 #include "ipm_road_mapper/core/io/geojson_export.h"
@@ -53,6 +56,7 @@
 #include "ipm_road_mapper/pipeline/progress_meter.h"
 #include "ipm_road_mapper/ros/bag_input.h"
 #include "ipm_road_mapper/ros/bag_mapping.h"
+#include "ipm_road_mapper/ros/bag_read_loss.h"
 
 namespace ipm_road_mapper {
 namespace {
@@ -110,14 +114,15 @@ MapperConfig LoadConfig(const std::string& path) {
 }
 
 // The rough extrinsic and where it came from (ChooseExtrinsic, as the nodelet decides it).
-Eigen::Isometry3d FindExtrinsic(const rosbag::Bag& bag, const InputOptions& input,
+Eigen::Isometry3d FindExtrinsic(rosbag::Bag* bag_ptr, const InputOptions& input,
                                 const std::string& mask_topic, std::string* source) {
+  const rosbag::Bag& bag = *bag_ptr;
   std::string camera_frame;
   if (!input.T_base_cam) {
-    rosbag::View masks(bag, rosbag::TopicQuery(mask_topic));
-    if (masks.size() == 0) throw InputError("topic " + mask_topic + " has no message");
-    const auto first = masks.begin()->instantiate<sensor_msgs::Image>();
-    camera_frame = first ? first->header.frame_id : "";
+    if (rosbag::View(bag, rosbag::TopicQuery(mask_topic)).size() == 0) {
+      throw InputError("topic " + mask_topic + " has no message");
+    }
+    camera_frame = FirstReadableMaskFrame(bag_ptr, mask_topic);
   }
   const TransformLookup lookup = [&bag](const std::string& parent, const std::string& child,
                                         Eigen::Isometry3d* T) {
@@ -139,6 +144,8 @@ struct RunStats {
   double wall_s = 0.0;
   std::optional<double> startup_s;  // process start to the first frame mapped
   std::string extrinsic_source;
+  BagReadLoss lost;          // what could not be read (corrupt chunks)
+  double bag_begin_s = 0.0;  // the bag's first record time; lost spans are relative to it
 };
 
 // One line about the optimizer: windows, solve time, how far the extrinsic moved.
@@ -208,6 +215,10 @@ std::string Summary(const Arguments& args, const Mapper& mapper, const FrameAsse
     << FrontEndLine(mapper) << "\n"
     << "startup_s: " << StartupText(stats.startup_s)
     << " (process start to the first frame mapped)\n"
+    << "lost: " << stats.lost.messages << " messages (" << stats.lost.masks << " masks) in "
+    << stats.lost.spans.size()
+    << " unreadable spans: " << FormatLostSpans(stats.lost, stats.bag_begin_s)
+    << (stats.lost.empty() ? "" : " (first error: " + stats.lost.first_error + ")") << "\n"
     << "wall time: " << stats.wall_s << " s; "
     << (stats.wall_s > 0 ? stats.frames_read / stats.wall_s : 0.0) << " frames/s; bag span "
     << stats.bag_span_s << " s; real-time factor "
@@ -243,10 +254,8 @@ int Run(int argc, char** argv) {
   }
   if (!fs::is_regular_file(args.bag)) throw InputError(args.bag + ": no such bag file");
   rosbag::Bag bag;
-  try {
-    bag.open(args.bag, rosbag::bagmode::Read);
-  } catch (const rosbag::BagException& e) {
-    throw InputError(args.bag + ": cannot read bag: " + e.what());
+  if (const std::string error = OpenBagForReading(args.bag, &bag); !error.empty()) {
+    throw InputError(error);
   }
   const InputOptions& input = options.input;
   const RosOptions& topics = config.ros;  // the bag's topic names and sync, as the nodelet's
@@ -257,7 +266,7 @@ int Run(int argc, char** argv) {
   if (!topic_error.empty()) throw InputError(args.bag + ": " + topic_error);
   RunStats stats;
   const Eigen::Isometry3d T_base_cam =
-      FindExtrinsic(bag, input, topics.mask_topic, &stats.extrinsic_source);
+      FindExtrinsic(&bag, input, topics.mask_topic, &stats.extrinsic_source);
   std::error_code dir_error;
   fs::create_directories(args.out, dir_error);
   if (dir_error || !fs::is_directory(args.out)) {
@@ -289,8 +298,12 @@ int Run(int argc, char** argv) {
     stats.startup_s = SecondsSinceProcessStart();
     std::fprintf(stderr, "map_from_bag: first frame mapped after %.3f s\n", *stats.startup_s);
   };
-  stats.frames_read = MapBag(bag, topics, &session, callbacks);
+  BagMappingResult read = MapBag(bag, topics, &session, callbacks);
   progress.Finish();
+  stats.frames_read = read.frames_read;
+  stats.lost = std::move(read.lost);
+  stats.bag_begin_s = rosbag::View(bag).getBeginTime().toSec();
+  if (!stats.lost.empty()) std::cerr << LostSpansLine(stats.lost, stats.bag_begin_s) << "\n";
   stats.wall_s = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
   stats.bag_span_s = (span_view.getEndTime() - span_view.getBeginTime()).toSec();
 
@@ -301,6 +314,8 @@ int Run(int argc, char** argv) {
   map.metadata["extrinsic_source"] = stats.extrinsic_source;
   // Process start to the first frame mapped, s (null when none was).
   map.metadata["startup_s"] = stats.startup_s ? nlohmann::json(*stats.startup_s) : nullptr;
+  // Messages of unreadable chunks and the spans of the bag they covered (docs/map_from_bag.md).
+  map.metadata["lost"] = LostSpansToJson(stats.lost, stats.bag_begin_s);
   const std::string summary = Summary(args, mapper, session.assembler(), map, stats);
   try {
     if (frame_stats) frame_stats->Close();

@@ -7,6 +7,9 @@
 #include <unistd.h>
 
 #include <cstdio>
+#include <filesystem>
+#include <fstream>
+#include <iterator>
 #include <string>
 
 #include "common/test_scene.h"
@@ -90,6 +93,82 @@ TEST_F(BagInputTest, MissingStaticTransform) {
   Eigen::Isometry3d T;
   const std::string error = LookupStaticTransform(bag_, "base_link", "lidar", &T);
   EXPECT_NE(error.find("no transform base_link -> lidar"), std::string::npos) << error;
+}
+
+// Writes the first `bytes` bytes of `from` to `to` (all when bytes is npos), with the 8 bytes
+// after "index_pos=" in the file header zeroed when `unclose`.
+void CopyBag(const std::string& from, const std::string& to, std::size_t bytes, bool unclose) {
+  std::ifstream in(from, std::ios::binary);
+  std::string data((std::istreambuf_iterator<char>(in)), std::istreambuf_iterator<char>());
+  if (bytes != std::string::npos) data.resize(bytes);
+  if (unclose) {
+    const std::size_t at = data.find("index_pos=");
+    ASSERT_LT(at, 4096u);
+    data.replace(at + 10, 8, std::string(8, '\0'));
+  }
+  std::ofstream(to, std::ios::binary) << data;
+}
+
+TEST_F(BagInputTest, IndexCheckOfAnIntactBag) {
+  const BagIndexCheck check = CheckBagIndex(path_);
+  EXPECT_TRUE(check.is_bag_v2);
+  EXPECT_FALSE(check.index_missing);
+  EXPECT_EQ(check.problem, "");
+  rosbag::Bag bag;
+  EXPECT_EQ(OpenBagForReading(path_, &bag), "");
+  EXPECT_TRUE(bag.isOpen());
+}
+
+TEST_F(BagInputTest, IndexCheckOfATruncatedBag) {
+  const std::string cut = path_ + ".cut.bag";
+  const std::size_t size = std::filesystem::file_size(path_);
+  // Half: before the index (this bag is small, its index a large part of it; a cut inside the
+  // index is not detected from the header, map_from_bag then suggests reindexing too).
+  CopyBag(path_, cut, size / 2, false);
+  rosbag::Bag bag;
+  EXPECT_THROW(bag.open(cut, rosbag::bagmode::Read), rosbag::BagException)
+      << "rosbag's C++ API refuses a bag without its index (what map_from_bag must explain)";
+  const BagIndexCheck check = CheckBagIndex(cut);
+  EXPECT_TRUE(check.is_bag_v2);
+  EXPECT_TRUE(check.index_missing);
+  EXPECT_NE(check.problem.find("truncated"), std::string::npos) << check.problem;
+  const std::string error = OpenBagForReading(cut, &bag);
+  EXPECT_NE(error.find("truncated"), std::string::npos) << error;
+  EXPECT_NE(error.find("run `rosbag reindex " + cut + "`"), std::string::npos) << error;
+  EXPECT_EQ(error.find('\n'), std::string::npos) << "one line";
+  // Cut inside the index: not visible in the header, still the suggestion.
+  CopyBag(path_, cut, size - 10, false);
+  const std::string index_error = OpenBagForReading(cut, &bag);
+  EXPECT_NE(index_error.find("rosbag reindex"), std::string::npos) << index_error;
+  std::remove(cut.c_str());
+}
+
+TEST_F(BagInputTest, IndexCheckOfAnUnclosedBag) {
+  const std::string open = path_ + ".open.bag";
+  CopyBag(path_, open, std::string::npos, true);
+  const BagIndexCheck check = CheckBagIndex(open);
+  EXPECT_TRUE(check.is_bag_v2);
+  EXPECT_TRUE(check.index_missing);
+  EXPECT_NE(check.problem.find("no index"), std::string::npos) << check.problem;
+  std::remove(open.c_str());
+}
+
+TEST_F(BagInputTest, IndexCheckOfNotABag) {
+  const std::string garbage = path_ + ".txt";
+  std::ofstream(garbage) << "not a bag at all, but longer than the version line";
+  EXPECT_FALSE(CheckBagIndex(garbage).is_bag_v2);
+  EXPECT_FALSE(CheckBagIndex(garbage).index_missing);
+  EXPECT_FALSE(CheckBagIndex(garbage).problem.empty());
+  rosbag::Bag bag;
+  const std::string error = OpenBagForReading(garbage, &bag);
+  EXPECT_NE(error.find("not a ROS bag"), std::string::npos) << error;
+  EXPECT_EQ(error.find("reindex"), std::string::npos) << error;
+  EXPECT_FALSE(CheckBagIndex(path_ + ".missing").is_bag_v2);
+  std::remove(garbage.c_str());
+  // A version line and then nothing: a damaged header, not a crash.
+  std::ofstream(garbage) << "#ROSBAG V2.0\n\xff\xff\xff\x7f";
+  EXPECT_FALSE(CheckBagIndex(garbage).is_bag_v2);
+  std::remove(garbage.c_str());
 }
 
 }  // namespace

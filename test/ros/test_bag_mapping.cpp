@@ -7,12 +7,14 @@
 #include <stdlib.h>
 #include <unistd.h>
 
+#include <cstdint>
 #include <cstdio>
 #include <string>
 #include <vector>
 
 #include "ipm_road_mapper/ros/bag_mapping.h"
 #include "ipm_road_mapper/ros/msg_conversion.h"
+#include "ros/bag_test_damage.h"
 
 namespace ipm_road_mapper {
 namespace {
@@ -118,7 +120,7 @@ TEST_F(BagMappingTest, EveryMaskIsOneFrameInBagOrder) {
     ++first_frame_reports;
     frames_before_first = frames.size();
   };
-  const std::size_t read = MapBag(bag_, topics, &session, callbacks);
+  const std::size_t read = MapBag(bag_, topics, &session, callbacks).frames_read;
 
   EXPECT_EQ(read, static_cast<std::size_t>(kMasks));
   ASSERT_EQ(frames.size(), static_cast<std::size_t>(kMasks));
@@ -139,8 +141,103 @@ TEST_F(BagMappingTest, WorksWithoutCallbacks) {
   options.backend.enabled = false;
   MappingSession session(options, Classes());
   session.Start(Extrinsic());
-  EXPECT_EQ(MapBag(bag_, RosOptions(), &session, {}), static_cast<std::size_t>(kMasks));
+  const BagMappingResult result = MapBag(bag_, RosOptions(), &session, {});
+  EXPECT_EQ(result.frames_read, static_cast<std::size_t>(kMasks));
+  EXPECT_TRUE(result.lost.empty());
   EXPECT_EQ(session.mapper()->counters().frames_used, static_cast<std::uint64_t>(kMasks - 2));
+}
+
+// A bag of kFrames masks in small LZ4 chunks (one mask each, incompressible background
+// noise), with two of its chunks corrupted: a damaged bag.
+class DamagedBagMappingTest : public ::testing::Test {
+ protected:
+  static constexpr int kFrames = 20;
+
+  void SetUp() override {
+    ros::Time::init();
+    char pattern[] = "/tmp/irm_damaged_bag_XXXXXX.bag";
+    const int fd = mkstemps(pattern, 4);
+    ASSERT_GE(fd, 0);
+    close(fd);
+    path_ = pattern;
+    {
+      rosbag::Bag bag(path_, rosbag::bagmode::Write);
+      bag.setCompression(rosbag::compression::LZ4);
+      bag.setChunkThreshold(8192);  // one chunk per frame (odometry, camera_info, mask)
+      std::uint32_t noise = 12345;
+      for (int k = 0; k < kFrames; ++k) {
+        for (int i = 0; i < 5; ++i) {  // 50 Hz odometry, recorded before the mask
+          nav_msgs::Odometry odom;
+          odom.header.stamp = ros::Time(kT0 + 0.1 * k + 0.02 * i);
+          odom.header.frame_id = "odom";
+          odom.child_frame_id = "base_link";
+          odom.pose.pose.position.x = 0.2 * (5 * k + i);
+          odom.pose.pose.orientation.w = 1.0;
+          bag.write("/odom", odom.header.stamp, odom);
+        }
+        sensor_msgs::Image mask;
+        mask.header.stamp = ros::Time(kT0 + 0.1 * k + 0.01);
+        mask.header.frame_id = "camera_optical";
+        mask.height = 48;
+        mask.width = 64;
+        mask.encoding = "16UC1";
+        mask.step = 2 * 64;
+        for (int p = 0; p < 64 * 48; ++p) {  // background values (< 1000) that do not compress
+          noise = noise * 1664525u + 1013904223u;
+          const std::uint16_t value = (noise >> 16) % 1000;
+          mask.data.push_back(value & 0xff);
+          mask.data.push_back(value >> 8);
+        }
+        sensor_msgs::CameraInfo info = IntrinsicsToCameraInfo(Camera());
+        info.header = mask.header;
+        bag.write("/camera/camera_info", mask.header.stamp, info);
+        bag.write("/camera/instances", mask.header.stamp + ros::Duration(0.001), mask);
+      }
+    }
+    test::CorruptChunk(path_, 5);
+    test::CorruptChunk(path_, 12);
+    bag_.open(path_, rosbag::bagmode::Read);  // the index at the end is intact
+  }
+  void TearDown() override {
+    bag_.close();
+    std::remove(path_.c_str());
+  }
+
+  std::string path_;
+  rosbag::Bag bag_;
+};
+
+TEST_F(DamagedBagMappingTest, SkipsUnreadableChunksAndMapsTheRest) {
+  MapperOptions options;
+  options.backend.enabled = false;
+  RosOptions topics;
+  topics.sync = "exact";
+  MappingSession session(options, Classes());
+  session.Start(Extrinsic());
+  std::vector<double> stamps;
+  BagMappingCallbacks callbacks;
+  callbacks.frame_done = [&](std::size_t, double stamp) { stamps.push_back(stamp); };
+  BagMappingResult result;
+  ASSERT_NO_THROW(result = MapBag(bag_, topics, &session, callbacks));
+
+  EXPECT_EQ(result.frames_read, static_cast<std::size_t>(kFrames)) << "lost masks count too";
+  EXPECT_EQ(stamps.size(), static_cast<std::size_t>(kFrames));
+  ASSERT_EQ(result.lost.spans.size(), 2u) << "two corrupt chunks, apart";
+  EXPECT_GE(result.lost.masks, 2u);
+  EXPECT_LT(result.lost.masks, 6u);
+  EXPECT_GE(result.lost.messages, result.lost.masks);
+  EXPECT_FALSE(result.lost.first_error.empty());
+  for (const LostSpan& span : result.lost.spans) {
+    EXPECT_LE(span.begin_s, span.end_s);
+    EXPECT_GE(span.begin_s, kT0);
+    EXPECT_LE(span.end_s, kT0 + 0.1 * kFrames);
+  }
+  EXPECT_LT(result.lost.spans[0].end_s, result.lost.spans[1].begin_s);
+  const MapperCounters& counters = session.mapper()->counters();
+  EXPECT_EQ(counters.frames_skipped.at("unreadable_chunk"), result.lost.masks);
+  EXPECT_GE(counters.frames_used, static_cast<std::uint64_t>(kFrames - 8))
+      << "the frames after a corrupt chunk are mapped";
+  EXPECT_EQ(counters.frames_used + counters.SkippedTotal(), static_cast<std::uint64_t>(kFrames));
 }
 
 }  // namespace

@@ -8,11 +8,14 @@
 #include <stdlib.h>
 #include <unistd.h>
 
+#include <cmath>
+#include <cstdint>
 #include <cstdio>
 #include <string>
 #include <vector>
 
 #include "ipm_road_mapper/ros/bag_prefetcher.h"
+#include "ros/bag_test_damage.h"
 
 namespace ipm_road_mapper {
 namespace {
@@ -126,6 +129,112 @@ TEST_F(BagPrefetcherTest, StopsCleanlyWhenTheConsumerLeavesEarly) {
     BagPrefetcher::Item item;
     ASSERT_TRUE(prefetcher.Next(&item));
   }  // each destructor joins a reader blocked on the full queue
+}
+
+// A bag whose first chunk holds all the odometry (written first) and each later chunk one
+// mask of incompressible bytes and a camera_info of the same record time, recorded between the
+// odometry messages: read in time order, the odometry chunk is decompressed again after every
+// mask chunk. One mask chunk (the 7th chunk of the file) is corrupt.
+class DamagedBagPrefetcherTest : public ::testing::Test {
+ protected:
+  static constexpr int kFrames = 12;
+  static constexpr int kCorruptChunk = 6;
+
+  void SetUp() override {
+    ros::Time::init();
+    char pattern[] = "/tmp/irm_prefetch_damaged_XXXXXX.bag";
+    const int fd = mkstemps(pattern, 4);
+    ASSERT_GE(fd, 0);
+    close(fd);
+    path_ = pattern;
+    {
+      rosbag::Bag bag(path_, rosbag::bagmode::Write);
+      bag.setCompression(rosbag::compression::LZ4);
+      bag.setChunkThreshold(16 * 1024);
+      for (int k = 0; k < kFrames; ++k) {
+        nav_msgs::Odometry odom;
+        odom.header.stamp = ros::Time(1000.0 + 0.1 * k);
+        odom.pose.pose.position.x = k;
+        bag.write("/odom", odom.header.stamp, odom);
+      }
+      std::uint32_t noise = 7;
+      for (int k = 0; k < kFrames; ++k) {
+        sensor_msgs::Image mask;
+        mask.header.stamp = ros::Time(1000.0 + 0.1 * k + 0.05);
+        mask.height = 100;
+        mask.width = 100;
+        mask.encoding = "16UC1";
+        mask.step = 200;
+        for (int p = 0; p < 20000; ++p) {
+          noise = noise * 1664525u + 1013904223u;
+          mask.data.push_back(static_cast<std::uint8_t>(noise >> 24));
+        }
+        sensor_msgs::CameraInfo info;
+        info.header.stamp = mask.header.stamp;
+        info.width = k;
+        bag.write("/camera/camera_info", mask.header.stamp, info);
+        bag.write("/camera/instances", mask.header.stamp, mask);
+      }
+    }
+    test::CorruptChunk(path_, kCorruptChunk);
+    bag_.open(path_, rosbag::bagmode::Read);
+  }
+  void TearDown() override {
+    bag_.close();
+    std::remove(path_.c_str());
+  }
+
+  std::string path_;
+  rosbag::Bag bag_;
+};
+
+TEST_F(DamagedBagPrefetcherTest, GoesOnAfterAnUnreadableChunkWithoutGarbage) {
+  BagPrefetcher prefetcher(bag_, {"/camera/instances", "/odom", "/camera/camera_info"}, 3);
+  BagPrefetcher::Item item;
+  int masks = 0, odometry = 0, unreadable_masks = 0, unreadable_infos = 0;
+  std::vector<double> unreadable_times;
+  std::vector<int> camera_info_frames;
+  while (prefetcher.Next(&item)) {
+    if (!item.read_error.empty()) {
+      // Each message of the corrupt chunk once: resuming at their record time skips, per
+      // topic, what was handled, whatever order the new View gives messages of equal time.
+      unreadable_masks += item.kind == BagPrefetcher::Kind::kMask;
+      unreadable_infos += item.kind == BagPrefetcher::Kind::kCameraInfo;
+      EXPECT_FALSE(item.mask || item.camera_info);
+      unreadable_times.push_back(item.bag_time_s);
+      continue;
+    }
+    if (item.kind == BagPrefetcher::Kind::kMask) {
+      ASSERT_TRUE(item.mask);
+      ++masks;
+      continue;
+    }
+    if (item.kind == BagPrefetcher::Kind::kCameraInfo) {
+      ASSERT_TRUE(item.camera_info);
+      camera_info_frames.push_back(static_cast<int>(item.camera_info->width));
+      continue;
+    }
+    // The odometry after the corrupt chunk comes from the intact first chunk: the exact
+    // values, not the bytes a failed decompression left in rosbag's chunk buffer.
+    ASSERT_TRUE(item.odometry) << "odometry " << odometry << " did not deserialize";
+    EXPECT_DOUBLE_EQ(item.odometry->pose.pose.position.x, odometry);
+    EXPECT_NEAR(item.bag_time_s, 1000.0 + 0.1 * odometry, 1e-6);
+    ++odometry;
+  }
+  EXPECT_EQ(unreadable_masks, 1);
+  EXPECT_EQ(unreadable_infos, 1);
+  EXPECT_EQ(masks, kFrames - 1);
+  // The lost frame is one frame of a mask chunk; every other camera_info once, in order.
+  ASSERT_EQ(unreadable_times.size(), 2u);
+  EXPECT_DOUBLE_EQ(unreadable_times[0], unreadable_times[1]);
+  const int lost_frame = static_cast<int>(std::lround((unreadable_times[0] - 1000.05) / 0.1));
+  EXPECT_GT(lost_frame, 0);
+  std::vector<int> expected_frames;
+  for (int k = 0; k < kFrames; ++k) {
+    if (k != lost_frame) expected_frames.push_back(k);
+  }
+  EXPECT_EQ(camera_info_frames, expected_frames);
+  EXPECT_EQ(odometry, kFrames) << "every odometry message exactly once (none repeated on resume)";
 }
 
 }  // namespace

@@ -34,10 +34,11 @@ class CameraInfoTable {
   explicit CameraInfoTable(double approximate_tolerance_s = kDefaultTolerance_s);
 
   // Half the median period between the header stamps of the first `sample` messages of
-  // the topic; only those are read (a 1 GB bag is not read through to start mapping).
-  // kDefaultTolerance_s with fewer than 2 distinct stamps.
+  // the topic; only those are read (a 1 GB bag is not read through to start mapping); an
+  // unreadable one (a corrupt chunk) ends the sample and sets *read_failed (the bag should then
+  // be reopened before it is read again). kDefaultTolerance_s with fewer than 2 distinct stamps.
   static double ToleranceFromFirstMessages(const rosbag::Bag& bag, const std::string& topic,
-                                           std::size_t sample = 20);
+                                           std::size_t sample = 20, bool* read_failed = nullptr);
 
   // Adds a camera_info (kept sorted by stamp; one that does not convert is kept with its
   // error, so a mask paired with it reports it). One older than the newest by more than

@@ -2,7 +2,8 @@
 // it: masks, odometry and camera_info read and deserialized ahead in the BagPrefetcher's
 // thread, each mask paired with its camera_info (CameraInfoPairing) and handed to the
 // session in bag order, so mapping starts with the first messages. Only the first
-// camera_infos are read beforehand (the "approximate" window). Offline only.
+// camera_infos are read beforehand (the "approximate" window). A message that cannot be read
+// (a corrupt chunk) is skipped and counted, and mapping goes on after it. Offline only.
 #pragma once
 
 #include <rosbag/bag.h>
@@ -13,6 +14,7 @@
 
 #include "ipm_road_mapper/pipeline/mapper_config.h"
 #include "ipm_road_mapper/pipeline/mapping_session.h"
+#include "ipm_road_mapper/ros/bag_read_loss.h"
 
 namespace ipm_road_mapper {
 
@@ -26,10 +28,20 @@ struct BagMappingCallbacks {
   std::function<void()> first_frame_mapped;
 };
 
+// What MapBag read.
+struct BagMappingResult {
+  // Mask messages handed to the session (used or skipped), unreadable ones included.
+  std::size_t frames_read = 0;
+  // The messages that could not be read; each lost mask is also a frame skipped as
+  // `unreadable_chunk`.
+  BagReadLoss lost;
+};
+
 // Maps the `topics` (ros: section) of the open bag into the started session, then finishes it
-// (waiting frames decided, the last window solved). Returns the number of frames read.
-// Throws rosbag::BagException on a corrupt bag (after the messages before it).
-std::size_t MapBag(const rosbag::Bag& bag, const RosOptions& topics, MappingSession* session,
-                   const BagMappingCallbacks& callbacks);
+// (waiting frames decided, the last window solved). A message whose chunk cannot be read is
+// skipped and counted in the result; other rosbag errors throw rosbag::BagException (after
+// the messages before it).
+BagMappingResult MapBag(const rosbag::Bag& bag, const RosOptions& topics, MappingSession* session,
+                        const BagMappingCallbacks& callbacks);
 
 }  // namespace ipm_road_mapper
