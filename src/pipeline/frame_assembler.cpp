@@ -2,6 +2,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <iterator>
 #include <sstream>
 #include <utility>
 
@@ -23,7 +24,8 @@ FrameAssembler::FrameAssembler(const OdometryOptions& odometry,
                                const FrameAssemblerOptions& options)
     : options_(options),
       poses_(odometry.stamp_tolerance_s, odometry.max_gap_s,
-             static_cast<std::size_t>(std::max(odometry.buffer_size, 2))) {
+             static_cast<std::size_t>(std::max(odometry.buffer_size, 2))),
+      odometry_capacity_(static_cast<std::size_t>(std::max(odometry.buffer_size, 2))) {
   if (options_.max_pending_frames == 0) options_.max_pending_frames = 1;
 }
 
@@ -34,7 +36,13 @@ bool FrameAssembler::AddOdometry(const StampedPose& pose) {
     return false;
   }
   if (have_odometry_stamp_ && pose.stamp <= newest_odometry_stamp_) {
-    if (newest_odometry_stamp_ - pose.stamp <= options_.time_jump_epsilon_s) {
+    const double late_s = newest_odometry_stamp_ - pose.stamp;
+    if (late_s <= ReorderWindow() && InsertLateOdometry(pose)) {
+      ++counters_.odometry_reordered;
+      ++counters_.odometry_used;
+      return true;
+    }
+    if (late_s <= std::max(options_.time_jump_epsilon_s, ReorderWindow())) {
       ++counters_.odometry_out_of_order;
       return false;
     }
@@ -45,7 +53,37 @@ bool FrameAssembler::AddOdometry(const StampedPose& pose) {
   newest_odometry_stamp_ = pose.stamp;
   // Cannot fail: the pose is valid and its stamp is after every buffered one.
   poses_.Add(pose);
+  odometry_.push_back(pose);
+  if (odometry_.size() > odometry_capacity_) odometry_.pop_front();
   ++counters_.odometry_used;
+  return true;
+}
+
+double FrameAssembler::ReorderWindow() const {
+  // The mean spacing of the newest few poses: the stream's current rate, robust to a gap
+  // long ago.
+  constexpr std::size_t kPeriodSamples = 10;
+  if (odometry_.size() < 2 || !(options_.reorder_periods > 0.0)) return 0.0;
+  const std::size_t n = std::min(odometry_.size(), kPeriodSamples);
+  const double span_s = odometry_.back().stamp - odometry_[odometry_.size() - n].stamp;
+  return options_.reorder_periods * span_s / static_cast<double>(n - 1);
+}
+
+bool FrameAssembler::InsertLateOdometry(const StampedPose& pose) {
+  const auto at = std::lower_bound(
+      odometry_.begin(), odometry_.end(), pose.stamp,
+      [](const StampedPose& buffered, double stamp) { return buffered.stamp < stamp; });
+  // Two stamps this close are one message (seen twice, or re-stamped by rounding).
+  constexpr double kDuplicateStampS = 1e-6;
+  if (at == odometry_.begin() || at == odometry_.end() ||
+      at->stamp - pose.stamp < kDuplicateStampS ||
+      pose.stamp - std::prev(at)->stamp < kDuplicateStampS) {
+    return false;
+  }
+  odometry_.insert(at, pose);
+  if (odometry_.size() > odometry_capacity_) odometry_.pop_front();
+  poses_.Clear();
+  for (const StampedPose& buffered : odometry_) poses_.Add(buffered);
   return true;
 }
 
@@ -110,6 +148,7 @@ void FrameAssembler::Reset() {
   }
   pending_.clear();
   poses_.Clear();
+  odometry_.clear();
   have_odometry_stamp_ = have_frame_stamp_ = false;
 }
 
@@ -120,6 +159,7 @@ void FrameAssembler::HandleTimeJump(const std::string& detail) {
   }
   pending_.clear();
   poses_.Clear();
+  odometry_.clear();
   // Both streams restart: the other stream's next (older) stamp is not a second jump.
   have_odometry_stamp_ = have_frame_stamp_ = false;
 }

@@ -207,6 +207,11 @@ std::string Summary(const Arguments& args, const Mapper& mapper, const FrameAsse
     << e.dropped_unknown_class << ", tiny " << e.dropped_tiny << ", border " << e.dropped_border
     << ", range " << e.dropped_range << ", degenerate " << e.dropped_degenerate
     << ", instance limit " << e.dropped_instance_limit << "\n"
+    << "implausible: " << e.dropped_oversized << " oversized markings, " << e.dropped_wide_lane
+    << " wide lanes (" << e.lane_runs_too_wide
+    << " lane runs too wide), frames without observations: " << e.frames_too_many_instances
+    << " too many instances, " << e.frames_too_much_coverage << " too much coverage ("
+    << e.dropped_absurd_frame << " instances); odometry reordered " << a.odometry_reordered << "\n"
     << "map: " << map.markings.size() << " markings, " << map.lanes.size() << " lanes (created "
     << c.markings_created << " markings, " << c.lanes_created << " lanes; spurious dropped "
     << c.spurious_dropped << ", lanes merged " << c.lanes_merged << ", lane observations unused "

@@ -466,7 +466,8 @@ TEST_F(InstanceExtractionTest, AllForegroundMaskIsBounded) {
 std::uint64_t Accounted(const FrameObservations& obs) {
   const ExtractionCounters& c = obs.counters;
   return obs.markings.size() + obs.lanes.size() + c.dropped_unknown_class + c.dropped_tiny +
-         c.dropped_border + c.dropped_range + c.dropped_degenerate + c.dropped_instance_limit;
+         c.dropped_border + c.dropped_range + c.dropped_degenerate + c.dropped_instance_limit +
+         c.dropped_oversized + c.dropped_wide_lane + c.dropped_absurd_frame;
 }
 
 // The n-th distinct instance value: classes 1..65 in turn, instance indices 0..999,
@@ -487,6 +488,7 @@ TEST_F(InstanceExtractionTest, TenThousandInstancesInTilesAreBounded) {
   options_.min_marking_pixels = 20;  // let the small tiles through to the instance limit
   options_.min_lane_pixels = 20;
   options_.min_lane_points = 2;
+  options_.max_plausible_instances = 100000;  // this test is about the instance limit
   const std::vector<std::uint16_t> values = DistinctValues(10000);
   ASSERT_EQ(values.size(), 10000u);
   cv::Mat mask = EmptyMask();
@@ -521,6 +523,7 @@ TEST_F(InstanceExtractionTest, TenThousandScatteredInstancesAreBounded) {
   }
   options_.min_marking_pixels = 20;
   options_.min_lane_pixels = 20;
+  options_.max_plausible_instances = 100000;  // the geometry's worst case, not the frame check
   const auto start = std::chrono::steady_clock::now();
   const FrameObservations obs = Extract(mask);
   const double ms = MsSince(start);
@@ -612,6 +615,12 @@ TEST(ExtractionCountersTest, AddSumsEveryCounter) {
   a.dropped_range = 5;
   a.dropped_degenerate = 6;
   a.dropped_instance_limit = 7;
+  a.dropped_oversized = 8;
+  a.dropped_wide_lane = 9;
+  a.dropped_absurd_frame = 10;
+  a.lane_runs_too_wide = 11;
+  a.frames_too_many_instances = 12;
+  a.frames_too_much_coverage = 13;
   b.Add(a);
   b.Add(a);
   EXPECT_EQ(b.instances_seen, 2u);
@@ -621,6 +630,12 @@ TEST(ExtractionCountersTest, AddSumsEveryCounter) {
   EXPECT_EQ(b.dropped_range, 10u);
   EXPECT_EQ(b.dropped_degenerate, 12u);
   EXPECT_EQ(b.dropped_instance_limit, 14u);
+  EXPECT_EQ(b.dropped_oversized, 16u);
+  EXPECT_EQ(b.dropped_wide_lane, 18u);
+  EXPECT_EQ(b.dropped_absurd_frame, 20u);
+  EXPECT_EQ(b.lane_runs_too_wide, 22u);
+  EXPECT_EQ(b.frames_too_many_instances, 24u);
+  EXPECT_EQ(b.frames_too_much_coverage, 26u);
 }
 
 }  // namespace

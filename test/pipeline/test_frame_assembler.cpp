@@ -194,6 +194,60 @@ TEST(FrameAssemblerTest, SmallReorderingIsNotATimeJump) {
   EXPECT_EQ(Keys(skipped), std::vector<std::string>{"out_of_order_frame"});
 }
 
+TEST(FrameAssemblerTest, SwappedOdometryIsReorderedNotAJump) {
+  FrameAssembler assembler(Odometry());
+  for (int i = 0; i <= 10; ++i) assembler.AddOdometry(PoseAt(10.0 + 0.02 * i));  // 50 Hz
+  assembler.AddFrame(10.25, SomeMask(), SomeCamera());  // waits for odometry
+  // 10.26 overtakes 10.24 (20 ms, one period): the late one is inserted in stamp order.
+  EXPECT_TRUE(assembler.AddOdometry(PoseAt(10.26)));
+  EXPECT_TRUE(assembler.AddOdometry(PoseAt(10.24)));
+  EXPECT_EQ(assembler.counters().time_jumps, 0u);
+  EXPECT_EQ(assembler.counters().odometry_reordered, 1u);
+  EXPECT_EQ(assembler.counters().odometry_out_of_order, 0u);
+  EXPECT_EQ(assembler.counters().odometry_used, 13u);
+  std::vector<std::string> skipped;
+  EXPECT_EQ(assembler.PopReady(&skipped).size(), 1u);  // the waiting frame was not flushed
+  EXPECT_TRUE(skipped.empty());
+  // A duplicate of a buffered stamp is out of order, not inserted.
+  EXPECT_FALSE(assembler.AddOdometry(PoseAt(10.24)));
+  EXPECT_EQ(assembler.counters().odometry_out_of_order, 1u);
+  EXPECT_EQ(assembler.counters().time_jumps, 0u);
+}
+
+TEST(FrameAssemblerTest, ReorderedOdometryIsInterpolated) {
+  FrameAssembler assembler(Odometry());
+  for (int i = 0; i <= 10; ++i) assembler.AddOdometry(PoseAt(10.0 + 0.02 * i));
+  assembler.AddOdometry(PoseAt(10.26));
+  StampedPose late = PoseAt(10.24);  // marked 1 m to the left
+  late.T_map_base.translation().y() = 1.0;
+  ASSERT_TRUE(assembler.AddOdometry(late));
+  assembler.AddFrame(10.25, SomeMask(), SomeCamera());
+  std::vector<std::string> skipped;
+  const std::vector<FrameInput> ready = assembler.PopReady(&skipped);
+  ASSERT_EQ(ready.size(), 1u);
+  // Halfway between the late pose (y = 1) and 10.26 (y = 0).
+  EXPECT_NEAR(ready[0].T_map_base_odom.translation().y(), 0.5, 0.02);
+}
+
+TEST(FrameAssemblerTest, JumpBackBeyondTheReorderWindowFlushes) {
+  FrameAssembler assembler(Odometry());
+  for (int i = 0; i <= 10; ++i) assembler.AddOdometry(PoseAt(10.0 + 0.02 * i));
+  assembler.AddFrame(10.25, SomeMask(), SomeCamera());
+  // 0.08 s back is 4 periods: beyond the 3-period window, a jump.
+  FrameAssembler four_periods(Odometry());
+  for (int i = 0; i <= 10; ++i) four_periods.AddOdometry(PoseAt(10.0 + 0.02 * i));
+  four_periods.AddOdometry(PoseAt(10.12 - 0.0001));
+  EXPECT_EQ(four_periods.counters().time_jumps, 1u);
+  // 2 s back: a jump; the waiting frame and the buffer are flushed.
+  EXPECT_TRUE(assembler.AddOdometry(PoseAt(8.2)));
+  EXPECT_EQ(assembler.counters().time_jumps, 1u);
+  EXPECT_EQ(assembler.counters().odometry_reordered, 0u);
+  std::vector<std::string> skipped;
+  EXPECT_TRUE(assembler.PopReady(&skipped).empty());
+  EXPECT_EQ(Keys(skipped), std::vector<std::string>{"time_jump"});
+  EXPECT_EQ(assembler.pending_frames(), 0u);
+}
+
 TEST(FrameAssemblerTest, InvalidOdometryIsCountedAndIgnored) {
   FrameAssembler assembler(Odometry());
   StampedPose nan_pose = PoseAt(1.0);

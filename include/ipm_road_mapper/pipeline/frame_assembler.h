@@ -13,10 +13,15 @@
 //   are "<key>: <detail>", keys: no_odometry, before_first_odometry, after_last_odometry,
 //   odometry_gap, invalid_stamp, out_of_order_frame, queue_overflow, time_jump (the part
 //   before ':' is the counter key, as Mapper::CountSkipped expects).
+// - Odometry a little out of order (older than the newest pose by at most
+//   reorder_periods odometry periods, the period measured from the buffered poses: a
+//   transport that swaps two messages) is inserted in stamp order and counted as
+//   odometry_reordered; a frame already returned keeps the pose it got. A duplicate stamp,
+//   or one older than the buffer, is out of order (ignored).
 // - A time jump backwards (an odometry or a mask stamp older than the newest one of its own
-//   stream by more than time_jump_epsilon_s: a bag loop, a restarted player) clears the
-//   waiting frames (skipped as time_jump) and the pose buffer and is counted. What happens
-//   to the map is the caller's decision.
+//   stream by more than time_jump_epsilon_s and, for odometry, the reorder window: a bag
+//   loop, a restarted player) clears the waiting frames (skipped as time_jump) and the pose
+//   buffer and is counted. What happens to the map is the caller's decision.
 // - When the queue is full, the oldest frame is dropped as queue_overflow (as no_odometry
 //   when no odometry has arrived at all, which is the more useful diagnosis).
 #pragma once
@@ -40,6 +45,7 @@ namespace ipm_road_mapper {
 struct FrameAssemblerOptions {
   std::size_t max_pending_frames = 50;  // frames waiting for odometry (5 s at 10 Hz)
   double time_jump_epsilon_s = 0.01;    // a stream going back by more than this: time jump
+  double reorder_periods = 3.0;         // odometry this many periods late is reordered (0 = never)
 };
 
 // What the assembler received and refused, for summaries and diagnostics. Frames it could
@@ -48,7 +54,8 @@ struct FrameAssemblerCounters {
   std::uint64_t odometry_received = 0;
   std::uint64_t odometry_used = 0;          // accepted into the pose buffer
   std::uint64_t bad_odometry = 0;           // non-finite stamp or pose, not a rotation
-  std::uint64_t odometry_out_of_order = 0;  // not after the newest, within the epsilon
+  std::uint64_t odometry_out_of_order = 0;  // duplicate or too old to insert, not a jump
+  std::uint64_t odometry_reordered = 0;     // late within the reorder window: inserted
   std::uint64_t time_jumps = 0;             // backwards jumps of either stream
   std::uint64_t frames_received = 0;
   std::uint64_t frames_ready = 0;                       // returned with a pose
@@ -62,9 +69,10 @@ class FrameAssembler {
                           const FrameAssemblerOptions& options = FrameAssemblerOptions());
 
   // Adds an odometry pose (T_map_base at its stamp). Returns false when the pose is not
-  // used: invalid (counted as bad_odometry) or not after the newest pose while within the
-  // epsilon (counted as odometry_out_of_order). A pose older by more than the epsilon is a
-  // time jump: the buffers are cleared and the pose starts the new stream (true).
+  // used: invalid (counted as bad_odometry), or not after the newest pose and neither
+  // insertable in the reorder window nor a jump (counted as odometry_out_of_order). A pose
+  // older by more than the reorder window and the epsilon is a time jump: the buffers are
+  // cleared and the pose starts the new stream (true).
   bool AddOdometry(const StampedPose& pose);
 
   // Queues a frame (the mask is shared, not copied). A frame whose stamp is not finite or
@@ -88,6 +96,12 @@ class FrameAssembler {
  private:
   // Drops every waiting frame and the pose buffer; counts one time jump.
   void HandleTimeJump(const std::string& detail);
+  // How far back (s) a late odometry pose may be and still be inserted: reorder_periods
+  // times the mean spacing of the newest buffered poses; 0 with fewer than two.
+  double ReorderWindow() const;
+  // Inserts a late pose into the buffer in stamp order; false for a duplicate stamp or one
+  // before the oldest buffered pose.
+  bool InsertLateOdometry(const StampedPose& pose);
   // Records a skipped frame with "<key>: <detail>".
   void Skip(const std::string& key, const std::string& detail);
   // Looks up the pose of the oldest waiting frame; appends it to `ready` or skips it.
@@ -97,6 +111,10 @@ class FrameAssembler {
 
   FrameAssemblerOptions options_;
   PoseBuffer poses_;
+  // The buffer's poses in stamp order (PoseBuffer only appends): rebuilt into poses_ when a
+  // late pose is inserted.
+  std::deque<StampedPose> odometry_;
+  std::size_t odometry_capacity_ = 2;
   std::deque<FrameInput> pending_;  // sorted by stamp
   std::vector<std::string> skipped_;
   bool have_odometry_stamp_ = false;

@@ -1,5 +1,7 @@
 #include "ipm_road_mapper/core/frontend/class_table.h"
 
+#include <algorithm>
+#include <optional>
 #include <string>
 
 namespace ipm_road_mapper {
@@ -34,6 +36,15 @@ ClassTable ClassTable::Load(OptionsReader reader) {
     entry.ReadRequired<std::string>("name", &info.name);
     entry.ReadRequired<std::string>("kind", &kind);
     entry.Read<std::string>("style", &style);
+    std::optional<double> max_width_m, max_length_m;
+    if (entry.Has("max_width_m")) {
+      max_width_m = 0.0;
+      entry.Read<double>("max_width_m", &*max_width_m, CheckPositive);
+    }
+    if (entry.Has("max_length_m")) {
+      max_length_m = 0.0;
+      entry.Read<double>("max_length_m", &*max_length_m, CheckPositive);
+    }
     entry.RejectUnknownKeys();
     const std::string where =
         entry.path() + " (id " + std::to_string(info.id) + ", " + info.name + ")";
@@ -43,6 +54,17 @@ ClassTable ClassTable::Load(OptionsReader reader) {
       info.kind = ElementKind::kMarking;
     } else {
       throw OptionsError(where + ": unknown kind '" + kind + "' (lane or marking)");
+    }
+    if (info.kind == ElementKind::kLane) {
+      if (max_length_m) throw OptionsError(where + ": max_length_m is for markings, not lanes");
+      info.max_width_m = max_width_m.value_or(kDefaultLaneMaxWidthM);
+    } else {
+      info.max_length_m = max_length_m.value_or(kDefaultMarkingMaxLengthM);
+      info.max_width_m =
+          max_width_m.value_or(std::min(kDefaultMarkingMaxWidthM, info.max_length_m));
+      if (info.max_width_m > info.max_length_m) {
+        throw OptionsError(where + ": max_width_m must be <= max_length_m");
+      }
     }
     if (style == "solid") {
       info.style = LaneStyle::kSolid;

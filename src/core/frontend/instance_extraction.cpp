@@ -62,6 +62,22 @@ void ApplyInstanceLimit(const MaskRuns& scan, int limit, std::vector<int>* slots
   std::sort(slots->begin(), slots->end(), by_value);
 }
 
+// True (and counted) when the candidates `slots` are no real frame's: more than
+// max_plausible_instances, or pixels covering more than max_coverage of the pixels below
+// the horizon. Every candidate is then counted as dropped_absurd_frame.
+bool IsAbsurdFrame(const MaskRuns& scan, const Ipm& ipm, const ExtractionOptions& options,
+                   const std::vector<int>& slots, ExtractionCounters* counters) {
+  if (slots.empty()) return false;
+  if (static_cast<int>(slots.size()) > options.max_plausible_instances) {
+    ++counters->frames_too_many_instances;
+  } else {
+    if (!extraction::CoversMoreThan(ipm, scan, slots, options.max_coverage)) return false;
+    ++counters->frames_too_much_coverage;
+  }
+  counters->dropped_absurd_frame += slots.size();
+  return true;
+}
+
 // The runs of the given instances, grouped by instance (row-major within each); *offsets
 // gets each slot's first index in the result (-1 for slots not asked for).
 std::vector<Run> GroupRuns(const MaskRuns& scan, const std::vector<int>& slots,
@@ -142,6 +158,10 @@ ExtractionOptions LoadExtractionOptions(OptionsReader reader) {
   reader.Read<int>("max_instances_per_frame", &o.max_instances_per_frame, CheckPositiveInt);
   reader.Read<double>("max_marking_range_m", &o.max_marking_range_m, CheckPositive);
   reader.Read<double>("min_rectangle_side_m", &o.min_rectangle_side_m, CheckNonNegative);
+  reader.Read<int>("max_plausible_instances", &o.max_plausible_instances, CheckPositiveInt);
+  reader.Read<double>("max_coverage", &o.max_coverage, [](const double& v) -> std::string {
+    return v > 0.0 && v <= 1.0 ? "" : "must be in (0, 1] (got " + std::to_string(v) + ")";
+  });
   reader.RejectUnknownKeys();
   return o;
 }
@@ -202,6 +222,7 @@ FrameObservations ExtractObservations(const cv::Mat& mask, const ClassTable& cla
     }
     slots.push_back(slot);
   }
+  if (IsAbsurdFrame(scan, ipm, options, slots, &counters)) return observations;
   ApplyInstanceLimit(scan, options.max_instances_per_frame, &slots, &counters);
 
   std::vector<int> offsets;
@@ -209,25 +230,29 @@ FrameObservations ExtractObservations(const cv::Mat& mask, const ClassTable& cla
   for (int slot : slots) {
     const InstanceStats& stats = scan.instances[slot];
     const Run* runs = grouped.data() + offsets[slot];
+    const ClassInfo& class_info = *classes.Find(ClassIdOf(stats.value));
     GeometryOutcome outcome;
     if (is_lane[slot]) {
       LaneObservation lane;
       lane.class_id = ClassIdOf(stats.value);
       lane.instance_value = stats.value;
       lane.pixel_count = stats.pixel_count;
-      outcome = extraction::ExtractLane(runs, stats.run_count, ipm, error_model, options, &lane);
+      outcome = extraction::ExtractLane(runs, stats.run_count, class_info, ipm, error_model,
+                                        options, &lane, &counters.lane_runs_too_wide);
       if (outcome == GeometryOutcome::kOk) observations.lanes.push_back(std::move(lane));
     } else {
       MarkingObservation marking;
       marking.class_id = ClassIdOf(stats.value);
       marking.instance_value = stats.value;
       marking.pixel_count = stats.pixel_count;
-      outcome =
-          extraction::ExtractMarking(runs, stats.run_count, ipm, error_model, options, &marking);
+      outcome = extraction::ExtractMarking(runs, stats.run_count, class_info, ipm, error_model,
+                                           options, &marking);
       if (outcome == GeometryOutcome::kOk) observations.markings.push_back(marking);
     }
     if (outcome == GeometryOutcome::kRange) ++counters.dropped_range;
     if (outcome == GeometryOutcome::kDegenerate) ++counters.dropped_degenerate;
+    if (outcome == GeometryOutcome::kOversized) ++counters.dropped_oversized;
+    if (outcome == GeometryOutcome::kTooWide) ++counters.dropped_wide_lane;
   }
   return observations;
 }

@@ -222,9 +222,9 @@ void OrderCornersCanonically(std::array<Eigen::Vector3d, 4>* corners_base) {
   std::rotate(c.begin(), c.begin() + nearest, c.end());
 }
 
-GeometryOutcome ExtractMarking(const Run* runs, int run_count, const Ipm& ipm,
-                               const IpmErrorModel& error_model, const ExtractionOptions& options,
-                               MarkingObservation* marking) {
+GeometryOutcome ExtractMarking(const Run* runs, int run_count, const ClassInfo& class_info,
+                               const Ipm& ipm, const IpmErrorModel& error_model,
+                               const ExtractionOptions& options, MarkingObservation* marking) {
   marking->outline_uv = SubpixelOutline(RowEnds(runs, SignificantPieces(runs, run_count)));
   marking->outline_base.clear();
   marking->outline_base.reserve(marking->outline_uv.size());
@@ -244,19 +244,23 @@ GeometryOutcome ExtractMarking(const Run* runs, int run_count, const Ipm& ipm,
       options.min_rectangle_side_m) {
     return GeometryOutcome::kDegenerate;
   }
+  if (IsOversized(marking->outline_base, class_info)) return GeometryOutcome::kOversized;
   return SetMarkingRectangle(ipm, error_model, Eigen::Vector2d::UnitX(), marking)
              ? GeometryOutcome::kOk
              : GeometryOutcome::kRange;
 }
-GeometryOutcome ExtractLane(const Run* runs, int run_count, const Ipm& ipm,
-                            const IpmErrorModel& error_model, const ExtractionOptions& options,
-                            LaneObservation* lane) {
+GeometryOutcome ExtractLane(const Run* runs, int run_count, const ClassInfo& class_info,
+                            const Ipm& ipm, const IpmErrorModel& error_model,
+                            const ExtractionOptions& options, LaneObservation* lane,
+                            std::uint64_t* runs_too_wide) {
   if (run_count <= 0) return GeometryOutcome::kDegenerate;
   const int row_step = std::max(options.lane_row_step, 1);
   const int bottom_row = runs[run_count - 1].row;
   // A run cut by the image's side is not centered on the line: its center is no measurement.
   const int margin = std::max(options.border_margin_px, 0);
   const int last_col = ipm.camera().intrinsics().width - 1 - margin;
+  // Runs whose ground width was measured, and those of them too wide for a line.
+  int runs_measured = 0, runs_wide = 0;
   // Rows bottom (near) first; within a row, runs left to right.
   int end = run_count;
   while (end > 0) {
@@ -265,7 +269,6 @@ GeometryOutcome ExtractLane(const Run* runs, int run_count, const Ipm& ipm,
     while (begin > 0 && runs[begin - 1].row == row) --begin;
     if ((bottom_row - row) % row_step == 0) {
       for (int i = begin; i < end; ++i) {
-        if (runs[i].first_col < margin || runs[i].last_col > last_col) continue;
         const Eigen::Vector2d uv(0.5 * (runs[i].first_col + runs[i].last_col), row);
         LanePoint point;
         if (ipm.PixelToGround(uv, &point.p_base) != IpmStatus::kOk) continue;
@@ -273,6 +276,16 @@ GeometryOutcome ExtractLane(const Run* runs, int run_count, const Ipm& ipm,
         const std::optional<IpmUncertainty> uncertainty =
             ComputeIpmUncertainty(ipm.camera(), ipm.T_base_cam(), uv, error_model);
         if (!uncertainty) continue;
+        // A cut run is at least as wide as its visible part: the width check comes first.
+        const std::optional<double> width_m = RunGroundWidth(runs[i], ipm);
+        if (width_m) {
+          ++runs_measured;
+          if (*width_m > class_info.max_width_m + std::sqrt(uncertainty->score)) {
+            ++runs_wide;
+            continue;
+          }
+        }
+        if (runs[i].first_col < margin || runs[i].last_col > last_col) continue;
         point.uv = uv;
         point.score = uncertainty->score;
         point.cov_base = uncertainty->omega.topLeftCorner<2, 2>();
@@ -281,6 +294,8 @@ GeometryOutcome ExtractLane(const Run* runs, int run_count, const Ipm& ipm,
     }
     end = begin;
   }
+  *runs_too_wide += runs_wide;
+  if (2 * runs_wide > runs_measured) return GeometryOutcome::kTooWide;
   return static_cast<int>(lane->points.size()) >= options.min_lane_points
              ? GeometryOutcome::kOk
              : GeometryOutcome::kDegenerate;

@@ -7,6 +7,7 @@
 
 #include <cstdint>
 #include <opencv2/core.hpp>
+#include <optional>
 #include <vector>
 
 #include "ipm_road_mapper/core/frontend/instance_extraction.h"
@@ -48,7 +49,7 @@ struct MaskRuns {
 MaskRuns ScanMask(const cv::Mat& mask);
 
 // Why the geometry of one instance was rejected.
-enum class GeometryOutcome { kOk, kRange, kDegenerate };
+enum class GeometryOutcome { kOk, kRange, kDegenerate, kOversized, kTooWide };
 
 // Marking rectangle from the runs of one instance (row-major). The outline is the sub-pixel
 // convex outline of the instance's significant 8-connected pieces (all glyphs of a text
@@ -56,18 +57,43 @@ enum class GeometryOutcome { kOk, kRange, kDegenerate };
 // mapped to the ground (any failure: kRange, the marking is cut by the horizon or
 // the IPM range), then the rectangle along base_link's x axis is set (SetMarkingRectangle).
 // The rectangle's center also gets the x-y block of Omega_p at its pixel (center_cov_base).
-GeometryOutcome ExtractMarking(const Run* runs, int run_count, const Ipm& ipm,
-                               const IpmErrorModel& error_model, const ExtractionOptions& options,
-                               MarkingObservation* marking);
+// kOversized when the outline's minimum-area ground rectangle is longer than
+// class_info.max_length_m or wider than class_info.max_width_m.
+GeometryOutcome ExtractMarking(const Run* runs, int run_count, const ClassInfo& class_info,
+                               const Ipm& ipm, const IpmErrorModel& error_model,
+                               const ExtractionOptions& options, MarkingObservation* marking);
 
 // Lane centerline points from the runs of one instance (row-major): every
 // options.lane_row_step rows from the bottom row up, the center of each run of that row
 // (runs within border_margin_px of the image's left or right side are cut: skipped),
-// mapped to the ground with its IPM uncertainty. kDegenerate when fewer than
-// options.min_lane_points survive the IPM.
-GeometryOutcome ExtractLane(const Run* runs, int run_count, const Ipm& ipm,
-                            const IpmErrorModel& error_model, const ExtractionOptions& options,
-                            LaneObservation* lane);
+// mapped to the ground with its IPM uncertainty. A run whose ground width (the IPM of its
+// two outer pixel edges) exceeds class_info.max_width_m plus the IPM uncertainty at its
+// center (sqrt of the score) is no line: it gives no point and is added to
+// *runs_too_wide; checked before the side cut, since a cut run is at least that wide.
+// kTooWide when more than half of the runs measured are too wide; kDegenerate when fewer
+// than options.min_lane_points survive the IPM.
+GeometryOutcome ExtractLane(const Run* runs, int run_count, const ClassInfo& class_info,
+                            const Ipm& ipm, const IpmErrorModel& error_model,
+                            const ExtractionOptions& options, LaneObservation* lane,
+                            std::uint64_t* runs_too_wide);
+
+// Ground width (m, x-y in base_link) of a run: the distance between the IPM of its outer
+// pixel edges (first_col - 0.5 and last_col + 0.5 on its row); nullopt when an edge does
+// not map to the ground.
+std::optional<double> RunGroundWidth(const Run& run, const Ipm& ipm);
+
+// True when the outline's minimum-area rectangle on the ground is longer than
+// class_info.max_length_m or its shorter side is wider than class_info.max_width_m.
+bool IsOversized(const std::vector<Eigen::Vector2d>& outline_base, const ClassInfo& class_info);
+
+// Pixels of columns first_col..last_col of `row` whose ray descends below the horizon (the
+// pinhole model, distortion ignored: for a plausibility ratio, not a measurement).
+int PixelsBelowHorizon(const Ipm& ipm, int row, int first_col, int last_col);
+
+// True when the runs of the instances `slots` cover more than `max_coverage` of the image's
+// pixels below the horizon (false when no pixel is below the horizon).
+bool CoversMoreThan(const Ipm& ipm, const MaskRuns& scan, const std::vector<int>& slots,
+                    double max_coverage);
 
 // The rectangle with sides along `axis` (and across it) spanning `outline`,
 // counter-clockwise. `outline` must have at least one point, `axis` must not be zero.

@@ -10,6 +10,12 @@ void ExtractionCounters::Add(const ExtractionCounters& o) {
   dropped_range += o.dropped_range;
   dropped_degenerate += o.dropped_degenerate;
   dropped_instance_limit += o.dropped_instance_limit;
+  dropped_oversized += o.dropped_oversized;
+  dropped_wide_lane += o.dropped_wide_lane;
+  dropped_absurd_frame += o.dropped_absurd_frame;
+  lane_runs_too_wide += o.lane_runs_too_wide;
+  frames_too_many_instances += o.frames_too_many_instances;
+  frames_too_much_coverage += o.frames_too_much_coverage;
 }
 
 }  // namespace ipm_road_mapper

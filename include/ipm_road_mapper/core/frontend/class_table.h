@@ -19,12 +19,22 @@ enum class LaneStyle { kUnknown, kSolid, kDashed };
 const char* ToString(ElementKind kind);
 const char* ToString(LaneStyle style);
 
+// Default plausibility bounds on the ground (m) of a class that does not set its own: a
+// lane line is at most this wide; a marking's rectangle at most this long and wide.
+constexpr double kDefaultLaneMaxWidthM = 0.6;
+constexpr double kDefaultMarkingMaxLengthM = 20.0;
+constexpr double kDefaultMarkingMaxWidthM = 10.0;
+
 // One class of the table.
 struct ClassInfo {
   int id = 0;
   std::string name;
   ElementKind kind = ElementKind::kMarking;
   LaneStyle style = LaneStyle::kUnknown;
+  // Largest plausible size on the ground (m): a lane line's width; a marking's rectangle's
+  // longer side (max_length_m) and shorter side (max_width_m). Set from the kind's default.
+  double max_width_m = kDefaultMarkingMaxWidthM;
+  double max_length_m = kDefaultMarkingMaxLengthM;  // markings only
 };
 
 // Pixel value encoding of the 16UC1 instance masks.
@@ -38,7 +48,8 @@ inline int ClassIdOf(unsigned value) { return static_cast<int>(value) / kInstanc
 class ClassTable {
  public:
   // Loads `classes:` from YAML. Throws OptionsError naming the offending entry: a
-  // duplicate id or name, an unknown kind or style, an id out of 1..kMaxClassId.
+  // duplicate id or name, an unknown kind or style, an id out of 1..kMaxClassId, a size
+  // bound not > 0, max_length_m on a lane or a marking's max_width_m above its max_length_m.
   static ClassTable Load(OptionsReader reader);
   static ClassTable LoadFile(const std::string& path);
 

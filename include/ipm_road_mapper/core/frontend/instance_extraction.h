@@ -23,6 +23,12 @@ struct ExtractionOptions {
   int max_instances_per_frame = 300;   // beyond this, the remaining instances are dropped
   double max_marking_range_m = 25.0;   // marking whose ground center is farther: dropped
   double min_rectangle_side_m = 0.05;  // thinner ground rectangles are degenerate
+  // A frame with more candidate instances than this (known class, not tiny, not truncated)
+  // is no real segmentation: its observations are dropped (the pose is still used).
+  int max_plausible_instances = 100;
+  // Same when the candidates' pixels cover more than this fraction of the pixels below
+  // the horizon (a network gone wrong paints the whole road).
+  double max_coverage = 0.5;
 };
 
 // Reads the `extraction` section; throws OptionsError naming the bad key.
@@ -42,14 +48,19 @@ bool SetMarkingRectangle(const Ipm& ipm, const IpmErrorModel& error_model,
 
 // Extracts every instance of `mask` (which must pass ValidateMask; an unusable mask gives
 // nothing). One scan groups the pixels by value; unknown classes, tiny instances and markings
-// within border_margin_px of the border are dropped from its statistics; of the rest the
-// max_instances_per_frame largest are processed. Markings: sub-pixel outline of the
+// within border_margin_px of the border are dropped from its statistics; when the rest are
+// more than max_plausible_instances or cover more than max_coverage of the pixels below the
+// horizon, the frame gives no observation (counted); otherwise the max_instances_per_frame
+// largest are processed. Markings: sub-pixel outline of the
 // significant 8-connected pieces (every glyph of a text; specks under a tenth of the largest
 // piece are left out) -> IPM (any outline point failing: dropped_range) -> the rectangle
 // along base_link's x axis (SetMarkingRectangle) -> canonical corners, projected back for
-// the pixel measurements.
+// the pixel measurements; a rectangle (minimum-area, on the ground) longer or wider than the
+// class's max_length_m / max_width_m is dropped (oversized).
 // Lanes: every lane_row_step rows from the bottom, the center column of each run of the
-// instance's pixels in that row -> IPM point + uncertainty score. Results sorted by value.
+// instance's pixels in that row -> IPM point + uncertainty score; a run wider on the ground
+// than the class's max_width_m plus the IPM uncertainty gives no point, and an instance with
+// most runs too wide is dropped (wide). Results sorted by value.
 FrameObservations ExtractObservations(const cv::Mat& mask, const ClassTable& classes,
                                       const Ipm& ipm, const IpmErrorModel& error_model,
                                       const ExtractionOptions& options);

@@ -53,12 +53,18 @@ struct LaneObservation {
 // Why an instance (or a whole mask) was not used; counted, never silent.
 struct ExtractionCounters {
   std::uint64_t instances_seen = 0;
-  std::uint64_t dropped_unknown_class = 0;   // class id not in the class table
-  std::uint64_t dropped_tiny = 0;            // fewer pixels than the class kind's minimum
-  std::uint64_t dropped_border = 0;          // marking touching the image border (truncated)
-  std::uint64_t dropped_range = 0;           // beyond max range or above the horizon
-  std::uint64_t dropped_degenerate = 0;      // too few valid lane points / flat rectangle
-  std::uint64_t dropped_instance_limit = 0;  // more instances than max_instances_per_frame
+  std::uint64_t dropped_unknown_class = 0;      // class id not in the class table
+  std::uint64_t dropped_tiny = 0;               // fewer pixels than the class kind's minimum
+  std::uint64_t dropped_border = 0;             // marking touching the image border (truncated)
+  std::uint64_t dropped_range = 0;              // beyond max range or above the horizon
+  std::uint64_t dropped_degenerate = 0;         // too few valid lane points / flat rectangle
+  std::uint64_t dropped_instance_limit = 0;     // more instances than max_instances_per_frame
+  std::uint64_t dropped_oversized = 0;          // marking larger than its class's max size
+  std::uint64_t dropped_wide_lane = 0;          // lane whose runs are mostly wider than a line
+  std::uint64_t dropped_absurd_frame = 0;       // candidates of frames dropped as absurd (below)
+  std::uint64_t lane_runs_too_wide = 0;         // lane runs (points) wider than a line: no point
+  std::uint64_t frames_too_many_instances = 0;  // frames over max_plausible_instances
+  std::uint64_t frames_too_much_coverage = 0;   // frames over max_coverage
   void Add(const ExtractionCounters& o);
 };
 
