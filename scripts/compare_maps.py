@@ -11,8 +11,8 @@ Markings: each marking of one map is matched to the nearest marking of the same 
 the other (center = mean of the 4 corners, xy distance, within --gate-m), both ways; the
 maps agree when at least --min-matched of each map's markings are matched and the mean
 center distance over the matches is at most --max-center-mean-m.
-Lanes: the splines are sampled every 0.5 m (the GeoJSON LineStrings next to each map.json,
-written by the same core code); for every sample of one map, the distance to the nearest
+Lanes: the splines of each map.json are sampled about every 0.5 m (uniform Catmull-Rom,
+phantom ends excluded, as docs/file_formats.md defines them); for every sample of one map, the distance to the nearest
 sample of the other. The maps agree when the mean distance is at most --max-lane-mean-m
 both ways, and at least --min-lane-cover of each map's samples lie within --lane-cover-m
 of the other map.
@@ -35,9 +35,23 @@ def quaternion_angle_deg(qa, qb):
     return math.degrees(2.0 * math.acos(min(1.0, dot)))
 
 
+def spline_samples(control_points, step_m=0.5):
+    """(x, y) about every step_m along a uniform Catmull-Rom spline (phantom ends excluded)."""
+    samples = []
+    for i in range(len(control_points) - 3):
+        c0, c1, c2, c3 = (control_points[i + k][:2] for k in range(4))
+        count = max(2, int(math.ceil(math.dist(c1, c2) / step_m)) + 1)
+        for j in range(0 if i == 0 else 1, count):
+            u = j / (count - 1.0)
+            samples.append(tuple(
+                0.5 * (2 * b + (c - a) * u + (2 * a - 5 * b + 4 * c - d) * u * u +
+                       (3 * b - 3 * c + d - a) * u ** 3)
+                for a, b, c, d in zip(c0, c1, c2, c3)))
+    return samples
+
+
 def load(path):
-    """(markings [(class_id, (x, y))], lane samples [(x, y)], map json) of a map.json and its
-    GeoJSON."""
+    """(markings [(class_id, (x, y))], lane samples [(x, y)], map json) of a map.json."""
     with open(path) as f:
         m = json.load(f)
     markings = []
@@ -45,17 +59,9 @@ def load(path):
         xs = [c[0] for c in k["corners"]]
         ys = [c[1] for c in k["corners"]]
         markings.append((k["class_id"], (sum(xs) / 4.0, sum(ys) / 4.0)))
-    stem = path[:-5] if path.endswith(".json") else path
-    geojson = stem + ".geojson"
     samples = []
-    with open(geojson) as f:
-        g = json.load(f)
-    if g.get("coordinate_system") != "local_metric_enu_m":
-        raise ValueError("%s: lanes must be in local coordinates (no geo_origin)" % geojson)
-    for feature in g["features"]:
-        geometry = feature.get("geometry")
-        if feature["properties"].get("kind") == "lane" and geometry:
-            samples.extend((p[0], p[1]) for p in geometry["coordinates"])
+    for lane in m["lanes"]:
+        samples.extend(spline_samples(lane["control_points"]))
     return markings, samples, m
 
 

@@ -100,10 +100,10 @@ echo
 echo "[demo] files:"
 for f in mapper/map.json mapper/map.geojson mapper/map_trajectory_tum.txt mapper/metrics.json \
          mapper/map.png mapper/summary.txt drive/drive.bag drive/ground_truth.json; do
-  echo "  $out/$f"
+  if [ -e "$out/$f" ]; then echo "  $out/$f"; fi
 done
 if [ "${IRM_DEMO_LIVE:-0}" = 1 ] && [ -f "$out/live/map.json" ]; then
   for f in live/map.json live/map.geojson live/map_trajectory_tum.txt live/metrics.json; do
-    echo "  $out/$f"
+    if [ -e "$out/$f" ]; then echo "  $out/$f"; fi
   done
 fi

@@ -1,10 +1,14 @@
 #!/usr/bin/python3
-"""Plot a vectorized road map against the ground truth of its drive.
+"""Plot a vectorized road map, alone or against the ground truth of its drive.
 
-    plot_map.py --map map.json --ground-truth ground_truth.json \
+    plot_map.py --map map.json [--ground-truth ground_truth.json] \
         [--metrics metrics.json] --out map.png
 
-One PNG: a top view of the whole drive (ground-truth lanes in gray, mapped splines colored
+Without --ground-truth (a map of a real drive): one top view of the map alone, the lane
+splines (solid / dashed by their style), the markings colored by class and the corrected
+trajectory, with the element counts and the lane length in the title.
+
+With --ground-truth, one PNG: a top view of the whole drive (ground-truth lanes in gray, mapped splines colored
 by their distance to the ground-truth lanes, markings colored by their center error, the
 true, odometry and corrected trajectories), zoomed views around individual markings, the
 per-marking x/y/z center errors, and the per-frame pose error. The headline metrics go
@@ -336,16 +340,58 @@ def draw_pose_errors(ax, vmap, gt):
     ax.grid(True, lw=0.3)
 
 
+def plot_map_alone(vmap, metrics, out):
+    """The map without ground truth: lanes, markings by class, corrected trajectory."""
+    fig, ax = plt.subplots(figsize=(14, 9))
+    lane_m = 0.0
+    for k, lane in enumerate(vmap["lanes"]):
+        samples = catmull_rom(lane["control_points"])
+        lane_m += float(np.sum(np.linalg.norm(np.diff(samples, axis=0), axis=1)))
+        ax.plot(samples[:, 0], samples[:, 1], color="seagreen", lw=1.5, zorder=3,
+                ls="--" if lane.get("style") == "dashed" else "-",
+                label="lane spline" if k == 0 else None)
+    classes = sorted({m.get("class_name") or str(m["class_id"]) for m in vmap["markings"]})
+    cmap = plt.get_cmap("tab10")
+    for m in vmap["markings"]:
+        name = m.get("class_name") or str(m["class_id"])
+        ax.add_patch(Polygon(np.asarray(m["corners"])[:, :2], closed=True, zorder=4,
+                             fc=cmap(classes.index(name) % 10), ec="k", lw=0.3, alpha=0.9))
+    trajectory = np.array([p["t"][:2] for p in vmap.get("trajectory", [])]).reshape(-1, 2)
+    if len(trajectory):
+        ax.plot(trajectory[:, 0], trajectory[:, 1], color="royalblue", lw=1.0, zorder=2,
+                label="corrected trajectory")
+    handles, _ = ax.get_legend_handles_labels()
+    handles += [Polygon([[0, 0]], fc=cmap(i % 10), ec="k", lw=0.3, label=name)
+                for i, name in enumerate(classes)]
+    if handles:
+        ax.legend(handles=handles, loc="upper left", fontsize=8)
+    ax.autoscale_view()
+    ax.set_aspect("equal", adjustable="datalim")
+    ax.set_xlabel("x [m] (map)")
+    ax.set_ylabel("y [m] (map)")
+    ax.grid(True, lw=0.3, alpha=0.5)
+    title = "Map (no ground truth): %d markings, %d lanes, %.3f km of lanes, %d poses" % (
+        len(vmap["markings"]), len(vmap["lanes"]), lane_m / 1000.0, len(trajectory))
+    if metrics is not None:
+        title += "\n" + headline(metrics)
+    ax.set_title(title, fontsize=11)
+    fig.savefig(out, dpi=110, bbox_inches="tight")
+    print("wrote %s" % out)
+
+
 def main():
     parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     parser.add_argument("--map", required=True, help="map JSON (SaveVectorMapJson)")
-    parser.add_argument("--ground-truth", required=True, help="ground-truth JSON")
+    parser.add_argument("--ground-truth", help="ground-truth JSON (without it: the map alone)")
     parser.add_argument("--metrics", help="metrics JSON written by evaluate_map --json")
     parser.add_argument("--out", required=True, help="output PNG")
     args = parser.parse_args()
     vmap = load_json(args.map, "map")
-    gt = load_json(args.ground_truth, "ground truth")
     metrics = load_json(args.metrics, "metrics") if args.metrics else None
+    if not args.ground_truth:
+        plot_map_alone(vmap, metrics, args.out)
+        return
+    gt = load_json(args.ground_truth, "ground truth")
 
     view = TopView(vmap, gt, metrics)
     fig = plt.figure(figsize=(17, 14))

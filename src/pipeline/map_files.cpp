@@ -70,36 +70,34 @@ MapFilePaths MapFilePathsAfterReset(const std::string& json_path, std::uint64_t 
   return MapFilePathsFor(stem + "_reset" + std::to_string(reset) + ".json");
 }
 
-void SaveMapFiles(const VectorMap& map, const std::optional<GeoOrigin>& geo_origin,
-                  const MapFilePaths& paths) {
+std::string SaveMapFiles(const VectorMap& map, const std::optional<GeoOrigin>& geo_origin,
+                         const MapFilePaths& paths) {
   for (const std::string* path : {&paths.json, &paths.geojson, &paths.tum}) CreateParent(*path);
-  const MapFilePaths temp{TemporarySibling(paths.json), TemporarySibling(paths.geojson),
-                          TemporarySibling(paths.tum)};
+  std::vector<std::pair<std::string, std::string>> moves = {
+      {TemporarySibling(paths.json), paths.json}};  // temporary -> final, in rename order
+  if (geo_origin) moves.emplace_back(TemporarySibling(paths.geojson), paths.geojson);
+  moves.emplace_back(TemporarySibling(paths.tum), paths.tum);
   auto remove_temporaries = [&] {
-    for (const std::string* path : {&temp.json, &temp.geojson, &temp.tum}) {
-      std::remove(path->c_str());
-    }
+    for (const auto& move : moves) std::remove(move.first.c_str());
   };
   // Each core writer is atomic and fsyncs its file; here under the temporary names.
   try {
-    SaveVectorMapJson(map, temp.json);
-    SaveGeoJson(map, geo_origin, temp.geojson);
-    WriteTumTrajectory(map.trajectory, temp.tum);
+    VectorMap recorded = map;  // the JSON records the origin the GeoJSON was made with
+    recorded.geo_origin = geo_origin;
+    SaveVectorMapJson(recorded, moves.front().first);
+    if (geo_origin) SaveGeoJson(map, geo_origin, moves[1].first);
+    WriteTumTrajectory(map.trajectory, moves.back().first);
   } catch (const std::exception& e) {
     remove_temporaries();
     // The core names the temporary file; the caller asked for the real one.
     std::string what = e.what();
-    for (const auto& [from, to] :
-         {std::pair{temp.json, paths.json}, std::pair{temp.geojson, paths.geojson},
-          std::pair{temp.tum, paths.tum}}) {
+    for (const auto& [from, to] : moves) {
       for (std::size_t at = what.find(from); at != std::string::npos; at = what.find(from)) {
         what.replace(at, from.size(), to);
       }
     }
     throw std::runtime_error(what);
   }
-  const std::vector<std::pair<std::string, std::string>> moves = {
-      {temp.json, paths.json}, {temp.geojson, paths.geojson}, {temp.tum, paths.tum}};
   for (const auto& [from, to] : moves) {
     if (std::rename(from.c_str(), to.c_str()) != 0) {
       const std::string reason = std::strerror(errno);
@@ -107,9 +105,12 @@ void SaveMapFiles(const VectorMap& map, const std::optional<GeoOrigin>& geo_orig
       throw std::runtime_error(to + ": cannot rename the temporary file into place: " + reason);
     }
   }
+  std::error_code ignored;  // a stale GeoJSON that cannot be removed is left, not fatal
+  if (!geo_origin) fs::remove(paths.geojson, ignored);
   std::set<std::string> folders;
   for (const auto& move : moves) folders.insert(fs::path(move.second).parent_path().string());
   for (const std::string& folder : folders) SyncFolder((fs::path(folder) / "x").string());
+  return geo_origin ? "" : kNoGeoJsonNote;
 }
 
 std::size_t MapElementCount(const VectorMap& map) { return map.markings.size() + map.lanes.size(); }

@@ -228,14 +228,16 @@ std::string Summary(const Arguments& args, const Mapper& mapper, const FrameAsse
     << (stats.wall_s > 0 ? stats.frames_read / stats.wall_s : 0.0) << " frames/s; bag span "
     << stats.bag_span_s << " s; real-time factor "
     << (stats.wall_s > 0 ? stats.bag_span_s / stats.wall_s : 0.0) << "x\n"
-    << "outputs: " << args.out << "/{map.json, map.geojson, map_trajectory_tum.txt, summary.txt}"
+    << "outputs: " << args.out << "/{map.json, " << (map.geo_origin ? "map.geojson, " : "")
+    << "map_trajectory_tum.txt, summary.txt}"
     << (args.stats_out.empty() ? "" : ", " + args.stats_out) << "\n";
   return s.str();
 }
 
 void WriteOutputs(const std::string& dir, const VectorMap& map,
                   const std::optional<GeoOrigin>& geo_origin, const std::string& summary) {
-  SaveMapFiles(map, geo_origin, MapFilePathsInFolder(dir));
+  const std::string note = SaveMapFiles(map, geo_origin, MapFilePathsInFolder(dir));
+  if (!note.empty()) std::cout << note << "\n";
   std::ofstream out(dir + "/summary.txt");
   out << summary;
   if (!out) throw std::runtime_error(dir + "/summary.txt: cannot write");
@@ -321,6 +323,7 @@ int Run(int argc, char** argv) {
   map.metadata["startup_s"] = stats.startup_s ? nlohmann::json(*stats.startup_s) : nullptr;
   // Messages of unreadable chunks and the spans of the bag they covered (docs/map_from_bag.md).
   map.metadata["lost"] = LostSpansToJson(stats.lost, stats.bag_begin_s);
+  map.geo_origin = config.geo_origin;  // recorded in map.json; the GeoJSON needs it
   const std::string summary = Summary(args, mapper, session.assembler(), map, stats);
   try {
     if (frame_stats) frame_stats->Close();

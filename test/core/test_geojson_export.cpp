@@ -4,12 +4,14 @@
 #include <gtest/gtest.h>
 #include <unistd.h>
 
+#include <GeographicLib/Geodesic.hpp>
 #include <cmath>
 #include <cstdlib>
 #include <filesystem>
 #include <fstream>
 #include <string>
 
+#include "ipm_road_mapper/core/geometry/catmull_rom_spline.h"
 #include "ipm_road_mapper/core/io/geojson_export.h"
 
 namespace ipm_road_mapper {
@@ -167,6 +169,47 @@ TEST(GeoJsonExportTest, WithOriginPositionsAreLonLatAltNearTheOrigin) {
   EXPECT_NEAR(line.back()[1].get<double>() - 48.0, 100.0 / 111200.0, 0.00001);
   // Control points stay local so the spline can be rebuilt.
   EXPECT_EQ(j["features"][1]["properties"]["control_points"][1], json::array({0.0, 0.0, 0.0}));
+}
+
+// Geodesic length (m, on the WGS84 ellipsoid) of a LineString's [lon, lat, alt] positions.
+double GeodesicLength_m(const json& line) {
+  const GeographicLib::Geodesic& wgs84 = GeographicLib::Geodesic::WGS84();
+  double length_m = 0.0;
+  for (std::size_t i = 0; i + 1 < line.size(); ++i) {
+    double segment_m = 0.0;
+    wgs84.Inverse(line[i][1].get<double>(), line[i][0].get<double>(), line[i + 1][1].get<double>(),
+                  line[i + 1][0].get<double>(), segment_m);
+    length_m += segment_m;
+  }
+  return length_m;
+}
+
+// With an origin, a GIS reader measures the lanes as long as the map (and the evaluator,
+// which sums the splines' arc lengths) does: the bug was local metres read as degrees.
+TEST(GeoJsonExportTest, GeodesicLaneLengthMatchesTheMapsLaneLength) {
+  VectorMap map;
+  MapLane straight;  // 600 m east
+  straight.id = 1;
+  for (int i = -1; i <= 13; ++i) straight.control_points_map.emplace_back(50.0 * i, 0.0, 0.0);
+  MapLane curve;  // a 400 m radius quarter circle
+  curve.id = 2;
+  for (int i = -1; i <= 11; ++i) {
+    const double angle = 0.5 * M_PI * i / 10.0;
+    curve.control_points_map.emplace_back(400.0 * std::cos(angle), 400.0 * std::sin(angle), 0.0);
+  }
+  map.lanes = {straight, curve};
+  for (const GeoOrigin& origin : {Munich(), GeoOrigin{-33.9, 18.4, 10.0}, GeoOrigin{64.1, -21.9}}) {
+    const json j = VectorMapToGeoJson(map, origin);
+    double geojson_m = 0.0, map_m = 0.0;
+    for (const MapLane& lane : map.lanes)
+      map_m += CatmullRomSpline(lane.control_points_map).Length();
+    for (const json& feature : j["features"]) {
+      ASSERT_EQ(feature["geometry"]["type"], "LineString");
+      geojson_m += GeodesicLength_m(feature["geometry"]["coordinates"]);
+    }
+    EXPECT_GT(map_m, 1200.0);
+    EXPECT_NEAR(geojson_m, map_m, 0.01 * map_m) << "origin latitude " << origin.latitude_deg;
+  }
 }
 
 TEST(GeoJsonExportTest, SaveWritesTheFileAtomically) {

@@ -220,6 +220,39 @@ TEST_F(MapIoTest, BadMapFilesThrowOneLineErrors) {
   EXPECT_NO_THROW(LoadVectorMapJson(Path("map.json")));
 }
 
+// The optional geo origin: absent by default, written and read back exactly, checked.
+TEST_F(MapIoTest, GeoOriginRoundTripAndValidation) {
+  VectorMap map = MakeMap();
+  EXPECT_FALSE(VectorMapToJson(map).contains("geo_origin"));
+  EXPECT_FALSE(VectorMapFromJson(VectorMapToJson(map)).geo_origin);
+  map.geo_origin = GeoOrigin{48.137154, 11.576124, 519.25};
+  SaveVectorMapJson(map, Path("geo.json"));
+  const VectorMap loaded = LoadVectorMapJson(Path("geo.json"));
+  ASSERT_TRUE(loaded.geo_origin);
+  EXPECT_EQ(loaded.geo_origin->latitude_deg, 48.137154);
+  EXPECT_EQ(loaded.geo_origin->longitude_deg, 11.576124);
+  EXPECT_EQ(loaded.geo_origin->altitude_m, 519.25);
+  nlohmann::json no_altitude = VectorMapToJson(map);
+  no_altitude["geo_origin"].erase("altitude_m");
+  EXPECT_EQ(VectorMapFromJson(no_altitude).geo_origin->altitude_m, 0.0);
+
+  const std::string path = Path("bad_geo.json");
+  auto mutated = [&](auto&& mutate) {
+    nlohmann::json j = VectorMapToJson(map);
+    mutate(j);
+    return j.dump();
+  };
+  ExpectMapRejected(path, mutated([](auto& j) { j["geo_origin"]["latitude_deg"] = 91.0; }),
+                    "geo_origin.latitude_deg");
+  ExpectMapRejected(path, mutated([](auto& j) { j["geo_origin"]["longitude_deg"] = -181.0; }),
+                    "geo_origin.longitude_deg");
+  ExpectMapRejected(path, mutated([](auto& j) { j["geo_origin"].erase("latitude_deg"); }),
+                    "geo_origin.latitude_deg");
+  ExpectMapRejected(path, mutated([](auto& j) { j["geo_origin"]["altitude_m"] = "high"; }),
+                    "geo_origin.altitude_m");
+  ExpectMapRejected(path, mutated([](auto& j) { j["geo_origin"] = 3; }), "geo_origin");
+}
+
 TEST_F(MapIoTest, PoseJsonRoundTripAndUnitQuaternion) {
   const Eigen::Isometry3d T = MakePose(1.0, -2.0, 3.0, 0.3, -0.2, 2.9);
   const nlohmann::json j = PoseToJson(T);

@@ -77,29 +77,51 @@ TEST(MapFiles, OneNamingRuleForFilesAndFolders) {
   EXPECT_EQ(MapFilePathsAfterReset("/tmp/live", 1).json, "/tmp/live_reset1.json");
 }
 
-TEST(MapFiles, SaveWritesExactlyTheThreeFiles) {
+const GeoOrigin kOrigin{48.0, 11.0, 500.0};
+
+TEST(MapFiles, SaveWritesExactlyTheThreeFilesWithAnOrigin) {
   const std::string dir = TempFolder("three");
   const VectorMap map = MapWith(2, 1);
-  SaveMapFiles(map, std::nullopt, MapFilePathsFor(dir + "/m.json"));
-  SaveMapFiles(map, std::nullopt, MapFilePathsFor(dir + "/m.json"));  // over existing ones
+  EXPECT_EQ(SaveMapFiles(map, kOrigin, MapFilePathsFor(dir + "/m.json")), "");
+  EXPECT_EQ(SaveMapFiles(map, kOrigin, MapFilePathsFor(dir + "/m.json")), "");  // over them
   EXPECT_EQ(FilesIn(dir),
             (std::set<std::string>{"m.json", "m.geojson", "m_trajectory_tum.txt"}));  // no temp
   const VectorMap loaded = LoadVectorMapJson(dir + "/m.json");
   EXPECT_EQ(loaded.markings.size(), 2u);
   EXPECT_EQ(loaded.lanes.size(), 1u);
+  ASSERT_TRUE(loaded.geo_origin) << "the origin is recorded in map.json";
+  EXPECT_EQ(loaded.geo_origin->latitude_deg, 48.0);
+  EXPECT_EQ(loaded.geo_origin->longitude_deg, 11.0);
+  EXPECT_EQ(loaded.geo_origin->altitude_m, 500.0);
+  EXPECT_NE(Read(dir + "/m.geojson").find("wgs84"), std::string::npos);
   EXPECT_FALSE(Read(dir + "/m_trajectory_tum.txt").empty());
+}
+
+// Without an origin the GeoJSON would hold local metres read as degrees: none is written,
+// the caller is told why, and one left by an earlier save with an origin is removed.
+TEST(MapFiles, NoGeoJsonWithoutAnOriginAndAStaleOneIsRemoved) {
+  const std::string dir = TempFolder("no_origin");
+  const MapFilePaths paths = MapFilePathsFor(dir + "/m.json");
+  EXPECT_EQ(SaveMapFiles(MapWith(2, 1), kOrigin, paths), "");
+  ASSERT_TRUE(fs::exists(paths.geojson));
+  const std::string note = SaveMapFiles(MapWith(2, 1), std::nullopt, paths);
+  EXPECT_EQ(note, kNoGeoJsonNote);
+  EXPECT_NE(note.find("geo_origin"), std::string::npos);
+  EXPECT_EQ(note.find('\n'), std::string::npos) << "one line";
+  EXPECT_EQ(FilesIn(dir), (std::set<std::string>{"m.json", "m_trajectory_tum.txt"}));
+  EXPECT_FALSE(LoadVectorMapJson(paths.json).geo_origin);
 }
 
 TEST(MapFiles, AFailedSaveReplacesNothingAndNamesTheRealFile) {
   const std::string dir = TempFolder("failed");
   const MapFilePaths paths = MapFilePathsFor(dir + "/m.json");
-  SaveMapFiles(MapWith(3, 2), std::nullopt, paths);
+  SaveMapFiles(MapWith(3, 2), kOrigin, paths);
   const std::string json = Read(paths.json), geojson = Read(paths.geojson), tum = Read(paths.tum);
 
   VectorMap bad = MapWith(1, 1);  // the map writer refuses what its reader would reject
   bad.markings[0].corners_map[0].x() = std::numeric_limits<double>::quiet_NaN();
   try {
-    SaveMapFiles(bad, std::nullopt, paths);
+    SaveMapFiles(bad, kOrigin, paths);
     FAIL() << "a map with NaN was saved";
   } catch (const std::runtime_error& e) {
     const std::string what = e.what();

@@ -128,7 +128,7 @@ TEST(MapFiles, NamesAndWriting) {
   StampedPose pose;
   pose.stamp = 1.0;
   map.trajectory.push_back(pose);
-  SaveMapFiles(map, std::nullopt, MapFilePathsFor(dir + "/m.json"));  // creates the folder
+  SaveMapFiles(map, GeoOrigin{48.0, 11.0, 0.0}, MapFilePathsFor(dir + "/m.json"));  // mkdir
   EXPECT_NO_THROW(LoadVectorMapJson(dir + "/m.json"));
   EXPECT_TRUE(std::filesystem::exists(dir + "/m.geojson"));
   std::ifstream tum(dir + "/m_trajectory_tum.txt");

@@ -44,7 +44,7 @@ TIMING = ["--max-center-mean-m", "0.8", "--min-matched", "0.5", "--max-lane-mean
 
 
 def shift_map(src_stem, dst_stem, dy):
-    """Copies map.json + map.geojson with everything moved by dy (m) along y."""
+    """Copies map.json with everything moved by dy (m) along y."""
     os.makedirs(os.path.dirname(dst_stem), exist_ok=True)
     with open(src_stem + ".json") as f:
         m = json.load(f)
@@ -56,14 +56,6 @@ def shift_map(src_stem, dst_stem, dy):
         pose["t"][1] += dy
     with open(dst_stem + ".json", "w") as f:
         json.dump(m, f)
-    with open(src_stem + ".geojson") as f:
-        g = json.load(f)
-    for feature in g["features"]:
-        geometry = feature["geometry"]
-        if geometry and geometry["type"] == "LineString":
-            geometry["coordinates"] = [[p[0], p[1] + dy, p[2]] for p in geometry["coordinates"]]
-    with open(dst_stem + ".geojson", "w") as f:
-        json.dump(g, f)
 
 
 class Collector:
@@ -215,9 +207,11 @@ class MapperBagTest(unittest.TestCase):
     def test_save_map_service_and_shutdown_save(self):
         self.assertTrue(self.save_response.success, self.save_response.message)
         for stem in ("live_service/map", "live_full/map", "live_fe/map"):
-            for suffix in (".json", ".geojson", "_trajectory_tum.txt"):
+            for suffix in (".json", "_trajectory_tum.txt"):
                 self.assertTrue(os.path.isfile(os.path.join(self.out, stem + suffix)),
                                 stem + suffix)
+            # No geo_origin in the config: no GeoJSON (local metres are not WGS84).
+            self.assertFalse(os.path.exists(os.path.join(self.out, stem + ".geojson")))
         self.assertEqual(self.unloaded, {"/mapper": True, "/mapper_fe": True})
         self.assertLess(self.timings["unload"], 60.0)
 

@@ -1,8 +1,9 @@
 #!/usr/bin/env bash
-# End-to-end test of evaluate_map and plot_map.py on a small drive written here: a 160 m road
-# (straight, then an arc) with 3 lane lines, 10 markings and 100 frames, and a map with
-# known damage (marking offsets, a duplicate, a false positive, a split lane, a lateral lane
-# offset, an extrinsic error, pose noise). Run by ctest in the devel space's environment.
+# End-to-end test of evaluate_map and plot_map.py (with and without ground truth) on a small
+# drive written here: a 160 m road (straight, then an arc) with 3 lane lines, 10 markings and
+# 100 frames, and a map with known damage (marking offsets, a duplicate, a false positive, a
+# split lane, a lateral lane offset, an extrinsic error, pose noise). Run by ctest in the
+# devel space's environment.
 set -e -o pipefail
 
 PYTHON=/usr/bin/python3
@@ -241,7 +242,14 @@ plot_map --map "$work/map.json" --ground-truth "$work/gt.json" --metrics "$work/
   --out "$work/map.png" || fail "plot_map.py exited with $?"
 plot_map --map "$work/map_no_traj.json" --ground-truth "$work/gt.json" \
   --out "$work/map_plain.png" || fail "plot_map.py without metrics exited with $?"
-for png in "$work/map.png" "$work/map_plain.png"; do
+# The map alone (a real drive has no ground truth): with and without a trajectory.
+plot_map --map "$work/map.json" --out "$work/map_alone.png" >"$work/alone.log" ||
+  fail "plot_map.py without --ground-truth exited with $?"
+grep -q "^wrote $work/map_alone.png$" "$work/alone.log" || fail "no 'wrote' line: $(cat "$work/alone.log")"
+plot_map --map "$work/map_no_traj.json" --out "$work/map_alone_no_traj.png" >/dev/null ||
+  fail "plot_map.py without --ground-truth and trajectory exited with $?"
+for png in "$work/map.png" "$work/map_plain.png" "$work/map_alone.png" \
+    "$work/map_alone_no_traj.png"; do
   [ -s "$png" ] || fail "$png missing"
   size=$(stat -c %s "$png")
   [ "$size" -gt 50000 ] || fail "$png is only $size bytes"

@@ -1,7 +1,8 @@
 #!/usr/bin/env bash
 # End-to-end test of `rosrun ipm_road_mapper map_from_bag` on a small drive generated here
 # (test/tools/make_test_bag.py): the outputs exist and parse, the marking lands where the
-# ground truth put it, the GeoJSON is accepted by a standard reader (python3-geojson and
+# ground truth put it, no GeoJSON without a geo origin (one line says why; a stale one is
+# removed), with one the GeoJSON is accepted by a standard reader (python3-geojson and
 # python3-shapely when installed; the structure is always checked by hand too), the
 # extrinsic comes from /tf_static or the config, approximate sync pairs shifted
 # camera_infos, a bag loop is counted, every kind of bad input exits 2 with one line, --help
@@ -126,9 +127,13 @@ EOF
 if run_mapper --bag "$work/drive.bag" --out "$work/out" >"$work/summary.log" 2>"$work/progress.log"; then
   pass "map_from_bag on drive.bag (default config)"
   cat "$work/summary.log"
-  for file in map.json map.geojson map_trajectory_tum.txt summary.txt; do
+  for file in map.json map_trajectory_tum.txt summary.txt; do
     [ -s "$work/out/$file" ] || fail "$file missing or empty"
   done
+  [ ! -e "$work/out/map.geojson" ] || fail "map.geojson written without a geo_origin"
+  [ "$(grep -c "^no GeoJSON: no geo_origin in the config" "$work/summary.log")" = 1 ] \
+    || fail "no single 'no GeoJSON' line on stdout"
+  grep -q "^outputs: .*map.geojson" "$work/out/summary.txt" && fail "summary lists map.geojson"
   grep -q "^frames read: 25$" "$work/out/summary.txt" || fail "summary: frames read is not 25"
   grep -q "^frames used: 25$" "$work/out/summary.txt" || fail "summary: not all 25 frames used"
   grep -q "frames/s" "$work/progress.log" || fail "no progress line on stderr"
@@ -138,33 +143,42 @@ else
   fail "map_from_bag on drive.bag (default config) exited $?:"; tail -5 "$work/progress.log"
 fi
 
-if [ "$default_run" = ok ]; then
-  check_geojson "$work/out/map.geojson" local_metric_enu_m || fail "map.geojson (default run) checks"
-fi
-
-# The plain-IPM ablation (a `base:` config) maps the lane too: a LineString in the GeoJSON.
+# The plain-IPM ablation (a `base:` config) maps the lane too (its curve: the control points
+# without the phantom ends).
 if run_mapper --bag "$work/drive.bag" --config "$repo/config/ablations/ipm.yaml" --out "$work/ipm" \
     >/dev/null 2>&1; then
-  check_geojson "$work/ipm/map.geojson" local_metric_enu_m || fail "map.geojson (ipm) checks"
+  [ ! -e "$work/ipm/map.geojson" ] || fail "map.geojson (ipm) written without a geo_origin"
   /usr/bin/python3 - "$work/ipm" <<'EOF' || fail "lane of the ipm run"
 import json, sys
 m = json.load(open(sys.argv[1] + "/map.json"))
-g = json.load(open(sys.argv[1] + "/map.geojson"))
 assert len(m["lanes"]) >= 1, "no lane mapped"
-lines = [f for f in g["features"] if f["properties"]["kind"] == "lane"]
-assert lines and lines[0]["geometry"]["type"] == "LineString"
-ys = [p[1] for p in lines[0]["geometry"]["coordinates"]]
+ys = [p[1] for p in m["lanes"][0]["control_points"][1:-1]]
 assert all(abs(y - 1.675) < 0.3 for y in ys), (min(ys), max(ys))
-print(f"ok: ipm config: {len(m['lanes'])} lane(s), LineString of {len(ys)} points near y = 1.675")
+print(f"ok: ipm config: {len(m['lanes'])} lane(s), {len(ys)} curve control points near y = 1.675")
 EOF
 else
   fail "map_from_bag with config/ablations/ipm.yaml"
 fi
 
-# 2. A geo origin: positions become lon/lat near it.
+# 2. A geo origin: the GeoJSON is written, positions become lon/lat near it, map.json records
+# the origin.
 geo_config=$(overlay geo.yaml "geo_origin: {latitude_deg: 48.0, longitude_deg: 11.0, altitude_m: 500.0}")
-if run_mapper --bag "$work/drive.bag" --config "$geo_config" --out "$work/geo" >/dev/null 2>&1; then
+if run_mapper --bag "$work/drive.bag" --config "$geo_config" --out "$work/geo" >"$work/geo.log" 2>&1; then
   check_geojson "$work/geo/map.geojson" wgs84 || fail "map.geojson (wgs84) checks"
+  grep -q "no GeoJSON" "$work/geo.log" && fail "'no GeoJSON' printed with a geo_origin"
+  /usr/bin/python3 -c '
+import json, sys
+o = json.load(open(sys.argv[1]))["geo_origin"]
+assert o == {"latitude_deg": 48.0, "longitude_deg": 11.0, "altitude_m": 500.0}, o' \
+    "$work/geo/map.json" && pass "map.json records the geo_origin" || fail "geo_origin in map.json"
+  # The same folder mapped again without an origin: the stale GeoJSON goes.
+  plain_config=$(overlay plain.yaml)
+  if run_mapper --bag "$work/drive.bag" --config "$plain_config" --out "$work/geo" >/dev/null 2>&1 &&
+     [ ! -e "$work/geo/map.geojson" ]; then
+    pass "a stale map.geojson is removed by a run without geo_origin"
+  else
+    fail "stale map.geojson left (or the run failed)"
+  fi
   /usr/bin/python3 - "$work/geo/map.geojson" <<'EOF' || fail "lon/lat of the arrow"
 import json, sys
 g = json.load(open(sys.argv[1]))

@@ -1,9 +1,9 @@
 // Writing a finished map to disk, the same way for the offline runner (map_from_bag --out)
-// and the nodelet (~save_map, the autosave and at shutdown): the map JSON, its GeoJSON and
-// the corrected trajectory in TUM format, named by one rule (MapFilePathsFor). A save is
-// atomic per file and all-or-nothing for the three: each is written and fsynced under a
-// temporary name in its own folder first, then the three are renamed into place. Also the
-// rule that keeps a live map saved before a ~reset (MapSaveTarget). No ROS header.
+// and the nodelet (~save_map, the autosave and at shutdown): the map JSON, its GeoJSON (only
+// with a geo origin) and the corrected trajectory in TUM format, named by one rule
+// (MapFilePathsFor). A save is atomic per file and all-or-nothing for the three: each is written
+// and fsynced under a temporary name in its own folder first, then the three are renamed into
+// place. Also the rule that keeps a live map saved before a ~reset (MapSaveTarget). No ROS header.
 #pragma once
 
 #include <cstddef>
@@ -20,7 +20,7 @@ namespace ipm_road_mapper {
 // Where the three files of one map go.
 struct MapFilePaths {
   std::string json;     // the map (docs/file_formats.md)
-  std::string geojson;  // RFC 7946 export
+  std::string geojson;  // RFC 7946 export (written only with a geo origin)
   std::string tum;      // corrected T_map_base per used frame
 };
 
@@ -37,12 +37,20 @@ MapFilePaths MapFilePathsInFolder(const std::string& folder);
 // `json_path`: "<stem>_reset<reset>.json" and its siblings (MapFilePathsFor).
 MapFilePaths MapFilePathsAfterReset(const std::string& json_path, std::uint64_t reset);
 
-// Creates the parent folders and writes the three files: all three under temporary names
-// (each fsynced), then renamed into place (json, geojson, tum: the TUM file is the last to
-// appear) and the folders fsynced. When any of them cannot be written, none of the
-// existing files is replaced. Throws std::runtime_error naming the file and the reason.
-void SaveMapFiles(const VectorMap& map, const std::optional<GeoOrigin>& geo_origin,
-                  const MapFilePaths& paths);
+// Why SaveMapFiles wrote no GeoJSON when it had no geo origin.
+constexpr const char* kNoGeoJsonNote =
+    "no GeoJSON: no geo_origin in the config (local metres are not WGS84)";
+
+// Creates the parent folders and writes the map files: the JSON (with `geo_origin` recorded
+// when there is one), the TUM trajectory and, only with a geo origin, the GeoJSON in WGS84.
+// All under temporary names (each fsynced), then renamed into place (json, geojson, tum: the
+// TUM file is the last to appear) and the folders fsynced. Without an origin a stale
+// `paths.geojson` of an earlier save is removed, so the folder never holds a GeoJSON that
+// disagrees with the JSON. When any file cannot be written, none of the existing files is
+// replaced. Returns "" when all three were written, else one line saying why the GeoJSON
+// was not (kNoGeoJsonNote). Throws std::runtime_error naming the file and the reason.
+std::string SaveMapFiles(const VectorMap& map, const std::optional<GeoOrigin>& geo_origin,
+                         const MapFilePaths& paths);
 
 // Markings + lanes: what "a map with fewer elements" counts.
 std::size_t MapElementCount(const VectorMap& map);

@@ -1,4 +1,5 @@
 // Map JSON reading and writing (format: docs/file_formats.md).
+#include <cmath>
 #include <iomanip>
 #include <set>
 #include <sstream>
@@ -98,6 +99,35 @@ nlohmann::json PoseToJson(const Eigen::Isometry3d& T) {
 
 Eigen::Isometry3d PoseFromJson(const nlohmann::json& j) { return json_io::ReadPose(j, ""); }
 
+namespace {
+
+nlohmann::json GeoOriginToJson(const GeoOrigin& origin) {
+  return {{"latitude_deg", origin.latitude_deg},
+          {"longitude_deg", origin.longitude_deg},
+          {"altitude_m", origin.altitude_m}};
+}
+
+// A number within [-limit, limit] (ReadNumber checks that it is finite).
+double ReadBounded(const nlohmann::json& j, const char* key, double limit,
+                   const std::string& where) {
+  const std::string at = Key(where, key);
+  const double value = json_io::ReadNumber(Member(j, key, where), at);
+  if (std::abs(value) > limit)
+    Fail(at, "must be in [-" + std::to_string(limit) + ", " + std::to_string(limit) + "]");
+  return value;
+}
+
+GeoOrigin GeoOriginFromJson(const nlohmann::json& j, const std::string& where) {
+  if (!j.is_object()) Fail(where, "expected an object");
+  GeoOrigin origin;
+  origin.latitude_deg = ReadBounded(j, "latitude_deg", 90.0, where);
+  origin.longitude_deg = ReadBounded(j, "longitude_deg", 180.0, where);
+  origin.altitude_m = json_io::OptionalNumber(j, "altitude_m", 0.0, where);
+  return origin;
+}
+
+}  // namespace
+
 nlohmann::json VectorMapToJson(const VectorMap& map) {
   nlohmann::json markings = nlohmann::json::array();
   for (const MapMarking& m : map.markings) markings.push_back(MarkingToJson(m));
@@ -109,15 +139,17 @@ nlohmann::json VectorMapToJson(const VectorMap& map) {
     entry["stamp"] = pose.stamp;
     trajectory.push_back(std::move(entry));
   }
-  return {{"format", kMapFormat},
-          {"version", kVectorMapFormatVersion},
-          {"frame_id", map.frame_id},
-          {"T_base_cam", PoseToJson(map.T_base_cam)},
-          {"T_base_cam_initial", PoseToJson(map.T_base_cam_initial)},
-          {"markings", markings},
-          {"lanes", lanes},
-          {"trajectory", trajectory},
-          {"metadata", map.metadata}};
+  nlohmann::json j = {{"format", kMapFormat},
+                      {"version", kVectorMapFormatVersion},
+                      {"frame_id", map.frame_id},
+                      {"T_base_cam", PoseToJson(map.T_base_cam)},
+                      {"T_base_cam_initial", PoseToJson(map.T_base_cam_initial)},
+                      {"markings", markings},
+                      {"lanes", lanes},
+                      {"trajectory", trajectory},
+                      {"metadata", map.metadata}};
+  if (map.geo_origin) j["geo_origin"] = GeoOriginToJson(*map.geo_origin);
+  return j;
 }
 
 VectorMap VectorMapFromJson(const nlohmann::json& j) {
@@ -169,6 +201,7 @@ VectorMap VectorMapFromJson(const nlohmann::json& j) {
     json_io::CheckDepth(j["metadata"], json_limits::kMaxDepth - 1, "metadata");
     map.metadata = j["metadata"];
   }
+  if (j.contains("geo_origin")) map.geo_origin = GeoOriginFromJson(j["geo_origin"], "geo_origin");
   return map;
 }
 

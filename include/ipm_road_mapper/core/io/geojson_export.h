@@ -19,7 +19,8 @@
 // - Without one: positions are the local metric [x, y, z] and "coordinate_system" is
 //   "local_metric_enu_m" (at the top level and in every feature's properties). RFC 7946
 //   removed the `crs` member, so there is no standard way to say this: readers will treat
-//   the numbers as degrees. Use it for plotting/inspection in a local frame only.
+//   the numbers as degrees. Use it for plotting/inspection in a local frame only; the map
+//   files (SaveMapFiles) never write a GeoJSON without an origin.
 #pragma once
 
 #include <nlohmann/json.hpp>
@@ -31,12 +32,7 @@
 
 namespace ipm_road_mapper {
 
-// Where the map frame's origin is on the Earth (config section `geo_origin`).
-struct GeoOrigin {
-  double latitude_deg = 0.0;   // WGS84, north positive, [-90, 90]
-  double longitude_deg = 0.0;  // WGS84, east positive, [-180, 180]
-  double altitude_m = 0.0;     // height above the WGS84 ellipsoid
-};
+// GeoOrigin (where the map frame's origin is on the Earth) is declared in vector_map.h.
 
 // Lane splines are sampled this often (arc length, m) for the LineStrings.
 constexpr double kLaneSampleSpacing_m = 0.5;

@@ -7,6 +7,7 @@
 #include <array>
 #include <cstdint>
 #include <nlohmann/json.hpp>
+#include <optional>
 #include <stdexcept>
 #include <string>
 #include <vector>
@@ -47,6 +48,14 @@ struct MapLane {
   double last_seen = 0.0;
 };
 
+// Where the map frame's origin is on the Earth (config section `geo_origin`); the map frame
+// is taken to be ENU (x east, y north, z up) there.
+struct GeoOrigin {
+  double latitude_deg = 0.0;   // WGS84, north positive, [-90, 90]
+  double longitude_deg = 0.0;  // WGS84, east positive, [-180, 180]
+  double altitude_m = 0.0;     // height above the WGS84 ellipsoid
+};
+
 // The whole exported map.
 struct VectorMap {
   std::string frame_id = "map";
@@ -56,6 +65,7 @@ struct VectorMap {
   Eigen::Isometry3d T_base_cam_initial = Eigen::Isometry3d::Identity();  // as handed in
   std::vector<StampedPose> trajectory;                 // corrected T_map_base per processed frame
   nlohmann::json metadata = nlohmann::json::object();  // method, config, counters, origin
+  std::optional<GeoOrigin> geo_origin;                 // when the map frame is geo-referenced
 };
 
 // Thrown when a map file cannot be read or does not follow the format; what() is one line.
