@@ -171,10 +171,11 @@ import json, sys
 o = json.load(open(sys.argv[1]))["geo_origin"]
 assert o == {"latitude_deg": 48.0, "longitude_deg": 11.0, "altitude_m": 500.0}, o' \
     "$work/geo/map.json" && pass "map.json records the geo_origin" || fail "geo_origin in map.json"
-  # The same folder mapped again without an origin: the stale GeoJSON goes.
+  # A copy of that folder mapped again without an origin: the stale GeoJSON goes.
+  cp -r "$work/geo" "$work/stale"
   plain_config=$(overlay plain.yaml)
-  if run_mapper --bag "$work/drive.bag" --config "$plain_config" --out "$work/geo" >/dev/null 2>&1 &&
-     [ ! -e "$work/geo/map.geojson" ]; then
+  if run_mapper --bag "$work/drive.bag" --config "$plain_config" --out "$work/stale" >/dev/null 2>&1 &&
+     [ ! -e "$work/stale/map.geojson" ]; then
     pass "a stale map.geojson is removed by a run without geo_origin"
   else
     fail "stale map.geojson left (or the run failed)"
