@@ -5,9 +5,11 @@
 #pragma once
 
 #include <opencv2/imgproc.hpp>
+#include <optional>
 #include <vector>
 
 #include "common/test_scene.h"
+#include "ipm_road_mapper/core/frontend/instance_extraction.h"
 #include "ipm_road_mapper/core/geometry/ipm.h"
 #include "ipm_road_mapper/core/mapper/mapper.h"
 
@@ -74,6 +76,25 @@ inline FrameInput RoadFrame(double stamp, double x_vehicle, bool with_arrow = tr
   }
   return in;
 }
+
+// What the Mapper's rooms share, for tests that drive a room alone: the options with the
+// effective gates, the scene's classes, a store and counters, and the front end's first step.
+struct RoomRig {
+  explicit RoomRig(MapperOptions o) : options(std::move(o)) {
+    options.association = EffectiveAssociationOptions(options);
+  }
+  // The frame's observations, extracted with T_base_cam (the IPM is written to *ipm).
+  FrameObservations Observe(const FrameInput& in, const Eigen::Isometry3d& T_base_cam,
+                            std::optional<Ipm>* ipm) const {
+    ipm->emplace(PinholeCamera(in.camera), T_base_cam, options.ipm.max_range_m);
+    return ExtractObservations(in.mask, classes, **ipm, options.ipm.error_model,
+                               options.extraction);
+  }
+  MapperOptions options;
+  ClassTable classes = TestClasses();
+  MapStore store{4.0};
+  MapperCounters counters;
+};
 
 }  // namespace test
 }  // namespace ipm_road_mapper

@@ -13,23 +13,16 @@ namespace {
 
 using namespace test;  // NOLINT: the scene's helpers
 
-struct Rig {
-  explicit Rig(MapperOptions o = MapperOptions()) : options(std::move(o)), store(4.0) {
-    options.association = EffectiveAssociationOptions(options);
-  }
+struct Rig : RoomRig {
+  explicit Rig(MapperOptions o = MapperOptions()) : RoomRig(std::move(o)) {}
   // Extracts the frame's observations and runs the tracker on them.
   void Step(const FrameInput& in) {
-    const Ipm ipm(PinholeCamera(in.camera), TestExtrinsic(), options.ipm.max_range_m);
-    FrameObservations obs =
-        ExtractObservations(in.mask, classes, ipm, options.ipm.error_model, options.extraction);
+    std::optional<Ipm> ipm;
+    FrameObservations obs = Observe(in, TestExtrinsic(), &ipm);
     const FrameRecord& frame = store.AddFrame(in.stamp, in.T_map_base_odom);
-    tracker.Update(ipm, frame, &obs.markings);
+    tracker.Update(*ipm, frame, &obs.markings);
     tracker.DropSpurious(frame.index);
   }
-  MapperOptions options;
-  ClassTable classes = TestClasses();
-  MapStore store;
-  MapperCounters counters;
   MarkingTracker tracker{options, &store, &counters};
 };
 

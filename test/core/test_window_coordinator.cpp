@@ -23,32 +23,26 @@ MapperOptions SynchronousOptions() {
   options.backend.synchronous = true;
   options.backend.window_frames = 20;
   options.backend.solve_every_n_frames = 5;
-  options.association = EffectiveAssociationOptions(options);
   return options;
 }
 
 // The Mapper's rooms, wired as the Mapper wires them, so a test can act between a window's
 // submission and the merge of its result.
-struct Rig {
-  explicit Rig(MapperOptions o) : options(std::move(o)) {}
+struct Rig : RoomRig {
+  explicit Rig(MapperOptions o) : RoomRig(std::move(o)) {}
   // One frame through the front end; true when the coordinator submitted a window.
   bool Step(const FrameInput& in) {
     windows.ApplyResults();
-    const Ipm ipm(PinholeCamera(in.camera), windows.T_base_cam(), options.ipm.max_range_m);
-    FrameObservations obs =
-        ExtractObservations(in.mask, classes, ipm, options.ipm.error_model, options.extraction);
+    std::optional<Ipm> ipm;
+    FrameObservations obs = Observe(in, windows.T_base_cam(), &ipm);
     const FrameRecord& frame = store.AddFrame(in.stamp, in.T_map_base_odom);
-    markings.Update(ipm, frame, &obs.markings);
+    markings.Update(*ipm, frame, &obs.markings);
     lanes.Update(obs.lanes, frame);
     ++counters.frames_used;
     const std::uint64_t solved = windows.stats().submitted;
     windows.OnFrameUsed(counters.frames_used, in.camera);
     return windows.stats().submitted > solved;
   }
-  MapperOptions options;
-  ClassTable classes = TestClasses();
-  MapStore store{4.0};
-  MapperCounters counters;
   MarkingTracker markings{options, &store, &counters};
   LaneTracker lanes{options, &store, &counters};
   WindowCoordinator windows{options, TestExtrinsic(), &store, &counters};

@@ -75,7 +75,6 @@ FrameStatus Mapper::ProcessFrame(const FrameInput& input, std::string* reason) {
   }
   ++counters_.frames_received;
   last_stamp_ = input.stamp;
-  camera_ = input.camera;
   windows_.ApplyResults();
 
   using Clock = std::chrono::steady_clock;
@@ -156,7 +155,7 @@ VectorMap Mapper::ExportMap(const ExportOptions& export_options) const {
     // Lanes no lane residual refines are re-fit to all their points, re-IPMed with the final
     // extrinsic and poses (PGO-IPM: lanes follow the refined extrinsic).
     lane.control_points_map =
-        refit ? lanes_.RefitControlPoints(element, camera_, windows_.T_base_cam())
+        refit ? lanes_.RefitControlPoints(element, windows_.camera(), windows_.T_base_cam())
               : element.control_points_map;
     lane.observations = static_cast<int>(element.Observations());
     lane.first_seen = element.first_seen;

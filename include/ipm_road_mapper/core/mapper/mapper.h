@@ -113,7 +113,6 @@ class Mapper {
   LaneTracker lanes_;
   WindowCoordinator windows_;  // last: destroyed first, joining the optimizer thread
   double last_stamp_ = -1.0;
-  CameraIntrinsics camera_;  // of the last used frame
 };
 
 }  // namespace ipm_road_mapper

@@ -52,6 +52,8 @@ class WindowCoordinator {
   // The extrinsic the front end uses: the rough one until a result refines it.
   const Eigen::Isometry3d& T_base_cam() const { return T_base_cam_; }
   BackendStats stats() const;
+  // The camera of the last used frame (the snapshots', and the export re-fit's).
+  const CameraIntrinsics& camera() const { return camera_; }
 
  private:
   // The first frame of the current window.
