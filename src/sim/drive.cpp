@@ -146,10 +146,14 @@ SimFrame DriveSimulator::RenderFrame(int k, const RenderSettings& settings) {
   RenderMask(context, settings.segmentation_noise, &frame);
   if (settings.image) RenderImage(context, &frame);
   if (settings.record_visibility) {
+    // Once per marking and frame, however many instances (split parts) show it.
+    std::vector<int> seen;
     for (const RenderedInstance& instance : frame.instances) {
-      if (instance.source == RenderedInstance::Source::kMarking)
-        ++visible_frames_[instance.gt_id - 1];
+      if (instance.source == RenderedInstance::Source::kMarking) seen.push_back(instance.gt_id);
     }
+    std::sort(seen.begin(), seen.end());
+    seen.erase(std::unique(seen.begin(), seen.end()), seen.end());
+    for (int gt_id : seen) ++visible_frames_[gt_id - 1];
   }
   return frame;
 }

@@ -6,6 +6,8 @@
 #include <opencv2/core.hpp>
 
 #include "ipm_road_mapper/sim/drive_simulator.h"
+#include "ipm_road_mapper/sim/instance_split.h"
+#include "ipm_road_mapper/sim/occluder.h"
 #include "ipm_road_mapper/sim/sim_random.h"
 
 namespace ipm_road_mapper {
@@ -19,6 +21,7 @@ constexpr int kShoulderGray = 105;
 constexpr int kAsphaltGray = 88;
 constexpr int kWhitePaintGray = 228;
 constexpr int kYellowPaintGray = 168;
+constexpr int kVehicleGray = 40;
 constexpr double kRoadQuadM = 2.0;
 
 // One instance being drawn: its mask value, the union of its fill boxes, where it came from.
@@ -33,6 +36,20 @@ int PaintGray(PaintColor color) {
 }
 
 bool Overlaps(double a0, double a1, double b0, double b1) { return a0 <= b1 && b0 <= a1; }
+
+// Fills the projection of every occluder box present at (s_cam, t_s) with `value`.
+void FillOccluders(const std::vector<OccluderOptions>& occluders, const RoadModel& road,
+                   const Eigen::Isometry3d& T_cam_map, double s_cam, double t_s,
+                   const FrustumProjector& projector, int value, cv::Mat* image) {
+  std::vector<Eigen::Vector3d> face_cam;
+  for (const OccluderOptions& occluder : occluders) {
+    for (const auto& face_map : OccluderFaces(road, occluder, s_cam, t_s)) {
+      face_cam.clear();
+      for (const Eigen::Vector3d& p_map : face_map) face_cam.push_back(T_cam_map * p_map);
+      FillPixelPolygon(projector.Project(face_cam), value, image);
+    }
+  }
+}
 
 }  // namespace
 
@@ -108,6 +125,9 @@ void DriveSimulator::RenderMask(const FrameContext& context, bool noise, SimFram
     }
     pending.push_back(p);
   }
+  // Vehicles ahead hide the paint behind them: background in the mask.
+  FillOccluders(scenario_.occluders, world_.road(), context.T_cam_map, context.s_cam,
+                context.index / scenario_.camera.rate_hz, mask_projector_, 0, &frame->mask);
   for (int b = 0; b < n_blobs; ++b) {
     // A small star-shaped polygon of a random marking class below the image's middle.
     const int class_id = marking_class_ids_[random.UniformInt(0, marking_class_ids_.size() - 1)];
@@ -126,18 +146,43 @@ void DriveSimulator::RenderMask(const FrameContext& context, bool noise, SimFram
     if (p.instance.value > 0) draw(blob, &p);
     pending.push_back(p);
   }
-  // Keep instances with enough pixels left after all drawing; erase the rest.
+  // Keep instances with enough pixels left after all drawing; erase the rest. A kept lane or
+  // marking instance may be split in two (its own stream, drawn for every candidate in
+  // order); the second part takes the next index above the candidates'.
+  SimRandom split_random = SimRandom::ForStream(seed_, RandomStream::kSplit, context.index);
+  const int min_pixels = std::max(1, seg.min_instance_pixels);
+  int next_index = candidates + 1;
+  std::vector<RenderedInstance> split_parts;
   for (Pending& p : pending) {
+    const bool split = split_random.Bernoulli(seg.split_instance_prob) && noise &&
+                       p.instance.source != RenderedInstance::Source::kSpurious;
+    const double angle = split_random.Uniform(0.0, M_PI);
     if (!p.drawn) continue;
     cv::Mat roi = frame->mask(p.roi);
     const cv::Mat hit = roi == p.instance.value;
     p.instance.pixels = cv::countNonZero(hit);
-    if (p.instance.pixels >= std::max(1, seg.min_instance_pixels)) {
-      frame->instances.push_back(p.instance);
-    } else if (p.instance.pixels > 0) {
-      roi.setTo(0, hit);
+    if (p.instance.pixels < min_pixels) {
+      if (p.instance.pixels > 0) roi.setTo(0, hit);
+      continue;
     }
+    if (split && next_index < kInstanceIdFactor) {
+      const int new_value = (p.instance.value / kInstanceIdFactor) * kInstanceIdFactor + next_index;
+      const int moved = SplitInstance(p.instance.value, new_value,
+                                      Eigen::Vector2d(std::cos(angle), std::sin(angle)), &roi);
+      if (moved >= min_pixels && p.instance.pixels - moved >= min_pixels) {
+        RenderedInstance part = p.instance;
+        part.value = new_value;
+        part.pixels = moved;
+        p.instance.pixels -= moved;
+        split_parts.push_back(part);
+        ++next_index;
+      } else if (moved > 0) {
+        roi.setTo(p.instance.value, roi == new_value);  // a sliver: keep the instance whole
+      }
+    }
+    frame->instances.push_back(p.instance);
   }
+  frame->instances.insert(frame->instances.end(), split_parts.begin(), split_parts.end());
 }
 
 void DriveSimulator::RenderImage(const FrameContext& context, SimFrame* frame) const {
@@ -202,6 +247,8 @@ void DriveSimulator::RenderImage(const FrameContext& context, SimFrame* frame) c
       }
     }
   }
+  FillOccluders(scenario_.occluders, road, context.T_cam_map, context.s_cam,
+                context.index / scenario_.camera.rate_hz, image_projector_, kVehicleGray, &image);
   // Fixed sensor texture (a repeating tile, so the image still compresses well).
   for (int r = 0; r < image.rows; ++r) {
     std::uint8_t* row = image.ptr<std::uint8_t>(r);

@@ -232,7 +232,29 @@ void ParseSegmentation(OptionsReader r, SegmentationNoiseOptions* o) {
   r.Read<double>("spurious_blobs_per_frame", &o->spurious_blobs_per_frame, CheckNonNegative);
   r.Read<double>("range_m", &o->range_m, CheckPositive);
   r.Read<int>("min_instance_pixels", &o->min_instance_pixels, CheckNonNegativeInt);
+  r.Read<double>("split_instance_prob", &o->split_instance_prob, CheckProbability);
   r.RejectUnknownKeys();
+}
+
+void ParseOccluder(OptionsReader* e, int lanes, OccluderOptions* o) {
+  e->Read<int>("lane", &o->lane, [lanes](const int& v) -> std::string {
+    return v >= 0 && v < lanes ? "" : "must be in 0.." + std::to_string(lanes - 1);
+  });
+  o->has_offset = e->Has("offset_m");
+  e->Read<double>("offset_m", &o->offset_m, CheckFinite);
+  e->Read<double>("gap_m", &o->gap_m, CheckPositive);
+  e->Read<double>("gap_amplitude_m", &o->gap_amplitude_m, CheckNonNegative);
+  e->Read<double>("gap_period_s", &o->gap_period_s, CheckPositive);
+  e->Read<double>("start_s_m", &o->start_s_m, CheckFinite);
+  e->Read<double>("end_s_m", &o->end_s_m, CheckFinite);
+  e->Read<double>("length_m", &o->length_m, CheckPositive);
+  e->Read<double>("width_m", &o->width_m, CheckPositive);
+  e->Read<double>("height_m", &o->height_m, CheckPositive);
+  if (o->gap_amplitude_m >= o->gap_m) {
+    throw OptionsError(e->KeyPath("gap_amplitude_m") +
+                       ": must be < gap_m (the vehicle ahead "
+                       "would reach the camera)");
+  }
 }
 
 }  // namespace
@@ -266,6 +288,11 @@ ScenarioOptions LoadScenario(OptionsReader reader, const ClassTable& classes) {
   ParseRough(reader.Child("rough_extrinsic"), &o.rough_extrinsic);
   ParseOdometry(reader.Child("odometry"), &o.odometry);
   ParseSegmentation(reader.Child("segmentation"), &o.segmentation);
+  ForEachEntry(&reader, "occluders", [&](OptionsReader* e) {
+    OccluderOptions occluder;
+    ParseOccluder(e, o.road.lanes, &occluder);
+    o.occluders.push_back(occluder);
+  });
   OptionsReader check = reader.Child("ipm_check");
   check.Read<double>("max_distance_m", &o.ipm_check.max_distance_m, CheckPositive);
   check.RejectUnknownKeys();
@@ -279,6 +306,9 @@ ScenarioOptions LoadScenario(OptionsReader reader, const ClassTable& classes) {
                        std::to_string(road_length) + " m long)");
   }
   if (o.camera.mount.z_m <= 0.0) throw OptionsError("camera.mount.z_m: must be > 0");
+  for (OccluderOptions& occluder : o.occluders) {
+    if (occluder.end_s_m < 0.0) occluder.end_s_m = road_length;
+  }
   return o;
 }
 

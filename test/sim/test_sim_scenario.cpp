@@ -38,7 +38,7 @@ std::string ErrorOf(const std::string& yaml) {
 }
 
 TEST(SimScenario, ShippedScenariosLoad) {
-  for (const char* name : {"public_road", "port", "hilly"}) {
+  for (const char* name : {"public_road", "port", "hilly", "urban", "curvy"}) {
     const std::string path = kSource + "/config/scenarios/" + name + ".yaml";
     ScenarioOptions o;
     ASSERT_NO_THROW(o = LoadScenarioFile(path, Classes())) << path;

@@ -155,6 +155,25 @@ struct SegmentationNoiseOptions {
   double spurious_blobs_per_frame = 0.2;  // Poisson mean
   double range_m = 40.0;                  // nothing deeper than this is rendered in the mask
   int min_instance_pixels = 12;           // smaller instances are erased
+  // Per frame, each lane or marking instance is cut in two along a random line through its
+  // pixel centroid with this probability; the second part gets a fresh instance index.
+  double split_instance_prob = 0.0;
+};
+
+// A vehicle driving ahead of the ego vehicle; its box hides the road behind it (drawn as
+// background, value 0, in the mask and dark in the image). Its rear is gap(t) = gap_m +
+// gap_amplitude_m sin(2 pi t / gap_period_s) ahead of the camera along the road (t from
+// the first frame), on a lane center or a lateral offset, heading along the road.
+struct OccluderOptions {
+  int lane = 1;             // drives this lane's center ...
+  bool has_offset = false;  // ... unless offset_m is given (lateral offset, left > 0)
+  double offset_m = 0.0;
+  double gap_m = 12.0;
+  double gap_amplitude_m = 0.0;
+  double gap_period_s = 20.0;
+  double start_s_m = 0.0;  // present while its rear is within [start_s_m, end_s_m] ...
+  double end_s_m = -1.0;   // ... (< 0: the road's length)
+  double length_m = 4.5, width_m = 1.8, height_m = 1.5;
 };
 
 // The plain-IPM error check of the generator (see ipm_check.h).
@@ -174,6 +193,7 @@ struct ScenarioOptions {
   RoughExtrinsicOptions rough_extrinsic;
   OdometryOptions odometry;
   SegmentationNoiseOptions segmentation;
+  std::vector<OccluderOptions> occluders;  // vehicles ahead
   IpmCheckOptions ipm_check;
 };
 

@@ -26,6 +26,7 @@ enum class RandomStream : std::uint64_t {
   kBodyMotion = 2,
   kSegmentation = 3,  // indexed by frame
   kImage = 4,
+  kSplit = 5,  // split instances, indexed by frame
 };
 
 // A seeded generator with platform-independent uniform and normal variates.
