@@ -4,7 +4,8 @@
 A gtest or rostest ctest entry counts its test cases (from the XML it writes under
 test_results/); any other ctest entry (shell tests, checks) counts as one. A ctest entry
 that failed without its XML saying so (a crash, a timeout) counts one extra failure, so a
-failure can never be hidden. Exit code: 0 only when nothing failed and ctest passed.
+failure can never be hidden; one that ctest did not run (a shell test exiting with its
+SKIP_RETURN_CODE, 77, when its data is absent) counts as skipped. Exit code: 0 only when nothing failed and ctest passed.
 """
 import glob
 import os
@@ -65,6 +66,8 @@ def main():
             passed += tests - fails - skips
             failed += fails
             skipped += skips
+        elif entry.get("status") == "notrun" or entry.find("skipped") is not None:
+            skipped += 1  # e.g. a shell test whose data is absent (SKIP_RETURN_CODE 77)
         else:
             failed += 1 if entry_failed else 0
             passed += 0 if entry_failed else 1
