@@ -1,7 +1,9 @@
 #!/usr/bin/env bash
-# Runs the ablations on the synthetic scenarios and prints the paper-style tables
+# Runs the ablations on the synthetic scenarios (and on ../shared/data/av2_pit_dev when it
+# is present) and prints the paper-style tables plus the issues' "Done when" rows
 # (scripts/benchmark.py). Drives are cached in out/benchmark/drives. Options are passed on:
-#   bash scripts/benchmark.sh [--scenarios public_road,port,hilly] [--quick]
+#   bash scripts/benchmark.sh [--scenarios public_road,port,hilly,urban,curvy,av2_pit_dev]
+#                             [--quick] [--jobs 2] [--shared <dir>]
 #   bash scripts/benchmark.sh --long     # the 10 km long-drive benchmark alone (docs/benchmark.md)
 set -eo pipefail
 repo="$(cd "$(dirname "${BASH_SOURCE[0]}")/.." && pwd)"

@@ -206,6 +206,8 @@ def report(args, drive, out, generate_time, map_time):
         fmt(solve[0], 1), fmt(solve[1], 1), md.get("backend_solves", "-"))])
     rows.append(["marking / lane APE, whole drive", "%s / %s m" % (
         fmt(whole.get("marking_ape_mean_m")), fmt(whole.get("lane_ape_mean_m")))])
+    rows.append(["splines per matched GT line / lane F1, whole drive", "%s / %s" % (
+        fmt(whole.get("lane_splines_per_matched_gt_lane"), 2), fmt(whole.get("lane_f1"), 2))])
     for k, (d0, d1, marking, lane, recall) in enumerate(sixths):
         rows.append(["marking / lane APE, sixth %d (%.1f-%.1f km)" % (k + 1, d0 / 1e3, d1 / 1e3),
                      "%s / %s m (marking recall %s)" % (fmt(marking), fmt(lane), fmt(recall, 2))])
