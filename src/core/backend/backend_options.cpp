@@ -111,6 +111,7 @@ BackendOptions LoadBackendOptions(OptionsReader reader) {
       });
   reader.Read<int>("extrinsic_holdout_every_n_frames", &o.extrinsic_holdout_every_n_frames,
                    [](const int& v) { return v == 0 || v >= 2 ? "" : "must be 0 or >= 2"; });
+  reader.Read<double>("extrinsic_holdout_sigmas", &o.extrinsic_holdout_sigmas, CheckNonNegative);
   reader.Read<int>("max_lane_points_per_observation", &o.max_lane_points_per_observation,
                    CheckPositiveInt);
   reader.Read<double>("max_lane_pixel_distance_m", &o.max_lane_pixel_distance_m, CheckPositive);
@@ -179,6 +180,7 @@ std::string ToString(const BackendOptions& o) {
     << k << "extrinsic_min_information_ratio: " << o.extrinsic_min_information_ratio << "\n"
     << k << "extrinsic_prior_memory_markings: " << o.extrinsic_prior_memory_markings << "\n"
     << k << "extrinsic_holdout_every_n_frames: " << o.extrinsic_holdout_every_n_frames << "\n"
+    << k << "extrinsic_holdout_sigmas: " << o.extrinsic_holdout_sigmas << "\n"
     << k << "max_lane_points_per_observation: " << o.max_lane_points_per_observation << "\n"
     << k << "max_lane_pixel_distance_m: " << o.max_lane_pixel_distance_m << "\n"
     << k << "max_outside_image_px: " << o.max_outside_image_px << "\n"

@@ -398,18 +398,24 @@ ceres::Solver::Summary MapStep(const WindowSnapshot& snapshot, const BackendOpti
 
 // The total robustified cost of the held-out measurements at the state's map, extrinsic and
 // poses: the evidence the guard judges an extrinsic by.
-double HeldOutCost(const WindowSnapshot& snapshot, const BackendOptions& options,
-                   WindowState* state, int* blocks) {
+// (Per held-out measurement, in the order they were added: the same order for any state of
+// one snapshot.)
+std::vector<double> HeldOutCosts(const WindowSnapshot& snapshot, const BackendOptions& options,
+                                 WindowState* state) {
   ceres::Problem problem;
   ceres::LossFunction* loss = MakeLoss(options);
-  *blocks =
+  const int blocks =
       AddMapStepMeasurements(snapshot, options, Measurements::kHeldOut, loss, state, &problem);
-  if (*blocks == 0) delete loss;  // the problem owns it only through a residual block
-  double cost = 0.0;
-  if (*blocks > 0) {
-    problem.Evaluate(ceres::Problem::EvaluateOptions(), &cost, nullptr, nullptr, nullptr);
+  if (blocks == 0) delete loss;  // the problem owns it only through a residual block
+  std::vector<ceres::ResidualBlockId> ids;
+  problem.GetResidualBlocks(&ids);
+  std::vector<double> costs;
+  for (ceres::ResidualBlockId id : ids) {
+    double cost = 0.0;
+    problem.EvaluateResidualBlock(id, true, &cost, nullptr, nullptr);
+    costs.push_back(cost);
   }
-  return cost;
+  return costs;
 }
 
 // The pose-update step: the window's poses free with their odometry priors; map and
@@ -569,8 +575,9 @@ void ObserveExtrinsic(const WindowSnapshot& snapshot, const BackendOptions& opti
 }
 
 // The guard against harm, after the first map step (the poses still the snapshot's): the
-// refined extrinsic is kept only when it explains the held-out frames' measurements better
-// than the starting one, each with the map re-fit to the training frames. Otherwise the
+// refined extrinsic is kept unless it explains the held-out frames' measurements worse
+// than the starting one (beyond their noise), each with the map re-fit to the training
+// frames. Otherwise the
 // state becomes the reference fit and the extrinsic stays held for the rest of the solve.
 // Nothing is judged when no direction was updated.
 void JudgeExtrinsic(const WindowSnapshot& snapshot, const BackendOptions& options,
@@ -578,16 +585,25 @@ void JudgeExtrinsic(const WindowSnapshot& snapshot, const BackendOptions& option
                     WindowResult* result) {
   state->hold_out = false;  // the later steps use every measurement
   if (!state->observability_valid || state->observability.rank == 0) return;
-  int held_out_blocks = 0;
-  result->holdout_cost_candidate = HeldOutCost(snapshot, options, state, &held_out_blocks);
+  const std::vector<double> candidate = HeldOutCosts(snapshot, options, state);
   reference->step_time_limit_s = time_limit_s;
   int blocks = 0;
   MapStep(snapshot, options, reference, &blocks);
-  result->holdout_cost_reference = HeldOutCost(snapshot, options, reference, &held_out_blocks);
-  result->holdout_blocks = held_out_blocks;
-  if (held_out_blocks > 0 && result->holdout_cost_candidate < result->holdout_cost_reference) {
-    return;
+  const std::vector<double> held = HeldOutCosts(snapshot, options, reference);
+  if (candidate.size() != held.size()) return;  // cannot happen: one snapshot, one order
+  // The difference of the costs and its spread over the measurements: worse beyond
+  // extrinsic_holdout_sigmas of that spread (an update that changes little moves the costs
+  // both ways by chance, and must not be refused by a coin flip) keeps the start.
+  double difference = 0.0, spread = 0.0;
+  for (std::size_t i = 0; i < held.size(); ++i) {
+    const double d = candidate[i] - held[i];
+    result->holdout_cost_candidate += candidate[i];
+    result->holdout_cost_reference += held[i];
+    difference += d;
+    spread += d * d;
   }
+  result->holdout_blocks = static_cast<int>(held.size());
+  if (difference <= options.extrinsic_holdout_sigmas * std::sqrt(spread)) return;
   result->extrinsic_rejected = true;
   *state = std::move(*reference);
   state->hold_out = false;

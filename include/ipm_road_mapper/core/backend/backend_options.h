@@ -70,9 +70,12 @@ struct BackendOptions {
   // retiring marking scales what is there by 1 - 1 / N (extrinsic_prior.h); 0: a plain sum.
   double extrinsic_prior_memory_markings = 50.0;
   // The guard against harm: every N-th frame's measurements are left out of the first map
-  // step and a refined extrinsic is accepted only when it explains them better than the
-  // previous one (with the map re-fit to each); otherwise the previous one stays. 0: off.
+  // step, and a refined extrinsic that explains them worse than the previous one (with the
+  // map re-fit to each) by more than extrinsic_holdout_sigmas times the spread of the
+  // per-measurement differences is refused: the previous one stays. N = 0: off. Sigmas 0:
+  // only an extrinsic that explains them at least as well is kept.
   int extrinsic_holdout_every_n_frames = 4;
+  double extrinsic_holdout_sigmas = 2.0;
   int max_lane_points_per_observation = 6;  // PPSR/PSR pixels per lane observation
   // A lane pixel whose IPM point is farther than this from its spline is not used.
   double max_lane_pixel_distance_m = 1.5;
