@@ -6,6 +6,7 @@
 #include <cmath>
 #include <numeric>
 
+#include "ipm_road_mapper/core/backend/extrinsic_observability.h"
 #include "ipm_road_mapper/core/geometry/rigid_transform.h"
 
 namespace ipm_road_mapper {
@@ -103,6 +104,7 @@ void FillOptimizerStatus(const MapperStatusSnapshot& now, const MapperStatusSnap
   s->add("windows unusable", b.unusable);
   s->add("results applied", now.counters.results_applied);
   s->add("results rejected", now.counters.results_rejected);
+  s->add("extrinsic updates rejected (held-out frames)", now.counters.extrinsic_rejected);
   const std::vector<double>& t = b.solve_times_s;
   const double total = std::accumulate(t.begin(), t.end(), 0.0);
   s->addf("solve time last (ms)", "%.1f", t.empty() ? 0.0 : 1e3 * t.back());
@@ -134,6 +136,13 @@ void FillExtrinsicStatus(const MapperStatusSnapshot& now, DiagnosticStatusWrappe
   s->addf("change translation (m)", "%.4f", change_m);
   s->addf("refined xyz (m)", "%.4f %.4f %.4f", t.x(), t.y(), t.z());
   s->addf("refined rpy (deg)", "%.4f %.4f %.4f", rpy.x(), rpy.y(), rpy.z());
+  const Eigen::Matrix<double, 6, 1> sigma =
+      now.T_base_cam_covariance.diagonal().cwiseMax(0.0).cwiseSqrt();
+  s->addf("sigma rpy (deg)", "%.4f %.4f %.4f", sigma(0) * 180.0 / M_PI, sigma(1) * 180.0 / M_PI,
+          sigma(2) * 180.0 / M_PI);
+  s->addf("sigma xyz (m)", "%.4f %.4f %.4f", sigma(3), sigma(4), sigma(5));
+  s->add("observed", ObservedAxesText(now.extrinsic_observed));
+  s->add("updates rejected (held-out frames)", now.counters.extrinsic_rejected);
   s->summary(DiagnosticStatus::OK, "known");
 }
 

@@ -279,6 +279,8 @@ MapperStatusSnapshot MappingWorker::Status() const {
     s.backend = mapper->backend_stats();
     s.T_base_cam_initial = mapper->T_base_cam_initial();
     s.T_base_cam = mapper->T_base_cam();
+    s.T_base_cam_covariance = mapper->T_base_cam_covariance();
+    s.extrinsic_observed = mapper->extrinsic_observed();
   }
   return s;
 }

@@ -47,6 +47,9 @@ ipm_road_mapper::VectorMapMsg ToVectorMapMsg(const VectorMap& map, const std::st
     msg.lanes.push_back(l);
   }
   msg.base_to_camera = IsometryToTransform(map.T_base_cam);
+  for (int i = 0; i < 36; ++i)
+    msg.base_to_camera_covariance[i] = map.T_base_cam_covariance(i / 6, i % 6);
+  for (int i = 0; i < 6; ++i) msg.base_to_camera_observed[i] = map.T_base_cam_observed[i];
   return msg;
 }
 
@@ -79,6 +82,9 @@ VectorMap FromVectorMapMsg(const ipm_road_mapper::VectorMapMsg& msg) {
   Eigen::Isometry3d T = Eigen::Isometry3d::Identity();
   if (TransformToIsometry(msg.base_to_camera, &T).empty()) map.T_base_cam = T;
   map.T_base_cam_initial = map.T_base_cam;
+  for (int i = 0; i < 36; ++i)
+    map.T_base_cam_covariance(i / 6, i % 6) = msg.base_to_camera_covariance[i];
+  for (int i = 0; i < 6; ++i) map.T_base_cam_observed[i] = msg.base_to_camera_observed[i];
   return map;
 }
 

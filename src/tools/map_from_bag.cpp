@@ -42,6 +42,7 @@
 #include <string>
 #include <utility>
 
+#include "ipm_road_mapper/core/backend/extrinsic_observability.h"
 #include "ipm_road_mapper/core/geometry/rigid_transform.h"
 #include "ipm_road_mapper/core/io/geojson_export.h"
 #include "ipm_road_mapper/core/map/vector_map.h"
@@ -70,8 +71,9 @@ struct InputError : std::runtime_error {
 
 struct Arguments {
   std::string bag, config, classes, out;
-  std::string stats_out;  // empty: no per-frame stats file
-  bool async = false;     // keep backend.synchronous as configured (live-like timing)
+  std::string stats_out;        // empty: no per-frame stats file
+  std::string calibration_out;  // empty: no calibration file
+  bool async = false;           // keep backend.synchronous as configured (live-like timing)
 };
 
 // A file of the package (e.g. "config/mapper.yaml"); see the file comment for the search.
@@ -99,7 +101,10 @@ std::optional<int> ParseArguments(int argc, char** argv, Arguments* args) {
             "in turn")
       .Required("out", "<dir>", &args->out, "output folder (created if needed)")
       .Optional("stats-out", "<file>", &args->stats_out, "none",
-                "per-frame CSV frame,stamp,cpu_s,rss_kb (docs/map_from_bag.md)");
+                "per-frame CSV frame,stamp,cpu_s,rss_kb (docs/map_from_bag.md)")
+      .Optional("calibration-out", "<file.yaml>", &args->calibration_out, "none",
+                "the refined extrinsic as a config whose input.extrinsic the next run reads, "
+                "with a static_transform_publisher line and a URDF joint (docs/map_from_bag.md)");
   return line.ParseOrExitCode(argc, argv);
 }
 
@@ -115,7 +120,8 @@ MapperConfig LoadConfig(const std::string& path) {
 
 // The rough extrinsic and where it came from (ChooseExtrinsic, as the nodelet decides it).
 Eigen::Isometry3d FindExtrinsic(rosbag::Bag* bag_ptr, const InputOptions& input,
-                                const std::string& mask_topic, std::string* source) {
+                                const std::string& mask_topic, std::string* source,
+                                std::string* camera_frame_out) {
   const rosbag::Bag& bag = *bag_ptr;
   std::string camera_frame;
   if (!input.T_base_cam) {
@@ -134,6 +140,7 @@ Eigen::Isometry3d FindExtrinsic(rosbag::Bag* bag_ptr, const InputOptions& input,
     throw InputError(error + "; set input.extrinsic in the config or record /tf_static");
   }
   *source = choice.source;
+  *camera_frame_out = camera_frame;
   return choice.T_base_cam;
 }
 
@@ -144,6 +151,7 @@ struct RunStats {
   double wall_s = 0.0;
   std::optional<double> startup_s;  // process start to the first frame mapped
   std::string extrinsic_source;
+  std::string camera_frame;  // the masks' frame (empty when the config gave the extrinsic)
   BagReadLoss lost;          // what could not be read (corrupt chunks)
   double bag_begin_s = 0.0;  // the bag's first record time; lost spans are relative to it
 };
@@ -164,6 +172,23 @@ std::string BackendLine(const Mapper& mapper) {
     << ", rejected " << mapper.counters().results_rejected << "; extrinsic moved "
     << RotationAngleBetween(mapper.T_base_cam_initial(), mapper.T_base_cam()) * 180.0 / M_PI
     << " deg, " << change.translation().norm() << " m";
+  return s.str();
+}
+
+// One line about the refined extrinsic as a calibration: its 1-sigma per axis, the axes the
+// data observed and how many refined extrinsics the guard refused.
+std::string CalibrationLine(const Mapper& mapper) {
+  const Eigen::Matrix<double, 6, 1> sigma =
+      mapper.T_base_cam_covariance().diagonal().cwiseMax(0.0).cwiseSqrt();
+  std::ostringstream s;
+  s.setf(std::ios::fixed);
+  s.precision(3);
+  s << "calibration: sigma roll pitch yaw " << sigma(0) * 180.0 / M_PI << " "
+    << sigma(1) * 180.0 / M_PI << " " << sigma(2) * 180.0 / M_PI << " deg, x y z " << sigma(3)
+    << " " << sigma(4) << " " << sigma(5)
+    << " m; observed: " << ObservedAxesText(mapper.extrinsic_observed())
+    << "; extrinsic updates rejected " << mapper.counters().extrinsic_rejected
+    << " (held-out frames explained worse)";
   return s.str();
 }
 
@@ -217,6 +242,7 @@ std::string Summary(const Arguments& args, const Mapper& mapper, const FrameAsse
     << c.spurious_dropped << ", lanes merged " << c.lanes_merged << ", lane observations unused "
     << c.lane_observations_unused << ", near a lane " << c.lane_observations_near_lane << ")\n"
     << BackendLine(mapper) << "\n"
+    << CalibrationLine(mapper) << "\n"
     << FrontEndLine(mapper) << "\n"
     << "startup_s: " << StartupText(stats.startup_s)
     << " (process start to the first frame mapped)\n"
@@ -230,7 +256,8 @@ std::string Summary(const Arguments& args, const Mapper& mapper, const FrameAsse
     << (stats.wall_s > 0 ? stats.bag_span_s / stats.wall_s : 0.0) << "x\n"
     << "outputs: " << args.out << "/{map.json, " << (map.geo_origin ? "map.geojson, " : "")
     << "map_trajectory_tum.txt, summary.txt}"
-    << (args.stats_out.empty() ? "" : ", " + args.stats_out) << "\n";
+    << (args.stats_out.empty() ? "" : ", " + args.stats_out)
+    << (args.calibration_out.empty() ? "" : ", " + args.calibration_out) << "\n";
   return s.str();
 }
 
@@ -273,7 +300,7 @@ int Run(int argc, char** argv) {
   if (!topic_error.empty()) throw InputError(args.bag + ": " + topic_error);
   RunStats stats;
   const Eigen::Isometry3d T_base_cam =
-      FindExtrinsic(&bag, input, topics.mask_topic, &stats.extrinsic_source);
+      FindExtrinsic(&bag, input, topics.mask_topic, &stats.extrinsic_source, &stats.camera_frame);
   std::error_code dir_error;
   fs::create_directories(args.out, dir_error);
   if (dir_error || !fs::is_directory(args.out)) {
@@ -328,6 +355,18 @@ int Run(int argc, char** argv) {
   try {
     if (frame_stats) frame_stats->Close();
     WriteOutputs(args.out, map, config.geo_origin, summary);
+    if (!args.calibration_out.empty()) {
+      Calibration calibration;
+      calibration.T_base_cam = map.T_base_cam;
+      calibration.covariance = map.T_base_cam_covariance;
+      calibration.observed = map.T_base_cam_observed;
+      calibration.base_frame = input.base_frame;
+      if (!stats.camera_frame.empty()) calibration.camera_frame = stats.camera_frame;
+      calibration.note = "from map_from_bag --bag " + args.bag + " --config " + args.config;
+      const std::string error = WriteCalibrationFile(
+          args.calibration_out, calibration, fs::absolute(args.config).lexically_normal().string());
+      if (!error.empty()) throw std::runtime_error(error);
+    }
   } catch (const std::exception& e) {
     std::cerr << "map_from_bag: error: " << e.what() << "\n";
     return 1;

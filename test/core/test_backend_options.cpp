@@ -84,6 +84,28 @@ TEST(BackendOptions, GatesAreReadAndValidated) {
             0u);
 }
 
+TEST(BackendOptions, ExtrinsicCalibrationOptionsAreReadAndValidated) {
+  const BackendOptions o = LoadFrom(
+      "{extrinsic_min_information_ratio: 2, extrinsic_prior_memory_markings: 0, "
+      "extrinsic_holdout_every_n_frames: 5}");
+  EXPECT_EQ(o.extrinsic_min_information_ratio, 2.0);
+  EXPECT_EQ(o.extrinsic_prior_memory_markings, 0.0);  // a plain sum
+  EXPECT_EQ(o.extrinsic_holdout_every_n_frames, 5);
+  EXPECT_EQ(ErrorOf([] {
+              LoadFrom("{extrinsic_holdout_every_n_frames: 1}");  // nothing left to fit
+            }).rfind("backend.extrinsic_holdout_every_n_frames: ", 0),
+            0u);
+  EXPECT_EQ(ErrorOf([] {
+              LoadFrom("{extrinsic_prior_memory_markings: 0.5}");
+            }).rfind("backend.extrinsic_prior_memory_markings: ", 0),
+            0u);
+  EXPECT_EQ(ErrorOf([] {
+              LoadFrom("{extrinsic_min_information_ratio: -1}");
+            }).rfind("backend.extrinsic_min_information_ratio: ", 0),
+            0u);
+  EXPECT_NE(ToString(o).find("backend.extrinsic_holdout_every_n_frames: 5\n"), std::string::npos);
+}
+
 TEST(BackendOptions, DumpListsTheKernelAndTheGates) {
   BackendOptions o;
   o.robust_kernel = RobustKernel::kCauchy;
@@ -102,6 +124,9 @@ TEST(BackendOptions, ShippedMapperYamlKeepsTheDefaults) {
   EXPECT_EQ(o.robust_kernel, ParseRobustKernel(backend["robust_kernel"].as<std::string>()));
   EXPECT_EQ(o.max_lane_pixel_distance_m, defaults.max_lane_pixel_distance_m);
   EXPECT_EQ(o.max_outside_image_px, defaults.max_outside_image_px);
+  EXPECT_EQ(o.extrinsic_min_information_ratio, defaults.extrinsic_min_information_ratio);
+  EXPECT_EQ(o.extrinsic_prior_memory_markings, defaults.extrinsic_prior_memory_markings);
+  EXPECT_EQ(o.extrinsic_holdout_every_n_frames, defaults.extrinsic_holdout_every_n_frames);
 }
 
 }  // namespace

@@ -177,6 +177,39 @@ TEST(MarginalizeIntoExtrinsic, HalfMarginalizedEqualsTheJointSolution) {
                 (T_sequential.translation() - T_joint.translation()).norm());
 }
 
+// A factor saying "delta = mean" with information `information` * I.
+ExtrinsicFactor FactorAt(const Eigen::Matrix<double, 6, 1>& mean, double information) {
+  ExtrinsicFactor factor;
+  factor.H = information * Eigen::Matrix<double, 6, 6>::Identity();
+  factor.delta_lin = mean;  // linearized at its own minimum: g = 0
+  return factor;
+}
+
+TEST(ExtrinsicPrior, ForgettingBoundsMemoryAndFollowsRecentData) {
+  // 200 batches that say a, then 200 that say b. A plain sum averages them and its
+  // information grows without bound; with a memory of 20 batches the prior follows b and
+  // its information stays near 20 batches' worth.
+  const Scene scene;
+  Eigen::Matrix<double, 6, 1> a = Eigen::Matrix<double, 6, 1>::Constant(0.01);
+  Eigen::Matrix<double, 6, 1> b = -a;
+  ExtrinsicPrior sum(scene.T_rough, Eigen::Vector3d::Constant(2.0 * kDeg),
+                     Eigen::Vector3d::Constant(0.05));
+  ExtrinsicPrior forgetting(scene.T_rough, Eigen::Vector3d::Constant(2.0 * kDeg),
+                            Eigen::Vector3d::Constant(0.05), 20.0);
+  for (int k = 0; k < 400; ++k) {
+    sum.Add(FactorAt(k < 200 ? a : b, 1e4));
+    forgetting.Add(FactorAt(k < 200 ? a : b, 1e4));
+  }
+  EXPECT_LT(sum.MeanDelta().norm(), 1e-3);  // the average of a and b, near 0
+  // (The mounting prior's pull toward 0 is under 1 % of 20 batches' information.)
+  EXPECT_LT((forgetting.MeanDelta() - b).norm(), 1e-2 * b.norm());
+  const double retired = (forgetting.H() - forgetting.H_mount()).trace() / 6.0;
+  EXPECT_NEAR(retired, 20.0 * 1e4, 0.05 * 20.0 * 1e4);
+  EXPECT_NEAR((sum.H() - sum.H_mount()).trace() / 6.0, 400.0 * 1e4, 1.0);
+  // The mounting prior is never forgotten.
+  EXPECT_EQ(forgetting.H_mount(), sum.H_mount());
+}
+
 TEST(MarginalizeIntoExtrinsic, EmptyInputGivesNoInformation) {
   const Scene scene;
   const ExtrinsicFactor factor = MarginalizeIntoExtrinsic(

@@ -68,6 +68,11 @@ VectorMap MakeMap() {
   map.lanes.push_back(lane);
   map.T_base_cam = MakePose(1.5, 0.02, 1.4, -M_PI / 2 - 0.01, 0.003, -M_PI / 2 + 0.02);
   map.T_base_cam_initial = MakePose(1.5, 0.0, 1.45, -M_PI / 2, 0.0, -M_PI / 2);
+  for (int i = 0; i < 6; ++i) {
+    for (int k = 0; k < 6; ++k)
+      map.T_base_cam_covariance(i, k) = (i == k ? 1e-4 : 1e-6) * (1 + i + 7 * k);
+  }
+  map.T_base_cam_observed = {true, true, false, false, true, true};
   for (int k = 0; k < 3; ++k) {
     map.trajectory.push_back({1700000000.0 + 0.05 * k, MakePose(k, 0.1 * k, 0.0, 0, 0, 0.01 * k)});
   }
@@ -105,6 +110,8 @@ void ExpectMapsEqual(const VectorMap& a, const VectorMap& b) {
   }
   ExpectPoseNear(a.T_base_cam, b.T_base_cam, 1e-9);
   ExpectPoseNear(a.T_base_cam_initial, b.T_base_cam_initial, 1e-9);
+  EXPECT_LT((a.T_base_cam_covariance - b.T_base_cam_covariance).cwiseAbs().maxCoeff(), 1e-15);
+  EXPECT_EQ(a.T_base_cam_observed, b.T_base_cam_observed);
   ASSERT_EQ(a.trajectory.size(), b.trajectory.size());
   for (std::size_t i = 0; i < a.trajectory.size(); ++i) {
     EXPECT_NEAR(a.trajectory[i].stamp, b.trajectory[i].stamp, 1e-9);

@@ -117,6 +117,16 @@ TEST(MapperDiagnostics, ExtrinsicChangeAndSolveTimes) {
   FillExtrinsicStatus(now, &e);
   EXPECT_EQ(Value(e, "change rotation (deg)"), "0.5000");
   EXPECT_EQ(Value(e, "change translation (m)"), "0.0500");
+  EXPECT_EQ(Value(e, "observed"), "none");
+  now.T_base_cam_covariance = Eigen::Matrix<double, 6, 6>::Identity() * 1e-4;  // 1 cm, 0.57 deg
+  now.extrinsic_observed = {false, true, true, false, false, true};
+  now.counters.extrinsic_rejected = 3;
+  DiagnosticStatusWrapper calibrated;
+  FillExtrinsicStatus(now, &calibrated);
+  EXPECT_EQ(Value(calibrated, "sigma xyz (m)"), "0.0100 0.0100 0.0100");
+  EXPECT_EQ(Value(calibrated, "sigma rpy (deg)"), "0.5730 0.5730 0.5730");
+  EXPECT_EQ(Value(calibrated, "observed"), "pitch yaw z");
+  EXPECT_EQ(Value(calibrated, "updates rejected (held-out frames)"), "3");
   now.backend_enabled = true;
   now.backend.solved = 2;
   now.backend.solve_times_s = {0.1, 0.3};

@@ -36,6 +36,9 @@ VectorMap SomeMap() {
   map.lanes.push_back(lane);
   map.T_base_cam.linear() = RotationFromRpy(-1.6, 0.05, -1.55);
   map.T_base_cam.translation() = Eigen::Vector3d(1.5, 0.02, 1.45);
+  map.T_base_cam_covariance = Eigen::Matrix<double, 6, 6>::Identity() * 1e-4;
+  map.T_base_cam_covariance(1, 5) = map.T_base_cam_covariance(5, 1) = -3e-5;  // pitch-height
+  map.T_base_cam_observed = {true, true, true, false, false, true};
   for (int i = 0; i < 10; ++i) {
     StampedPose pose;
     pose.stamp = 1000.0 + 0.1 * i;
@@ -55,8 +58,12 @@ TEST(VectorMapConversion, RoundTripKeepsEveryField) {
   EXPECT_EQ(msg.lanes[0].control_points.size(), 6u);
   EXPECT_DOUBLE_EQ(msg.markings[0].corners[2].y, 0.6);
 
+  EXPECT_DOUBLE_EQ(msg.base_to_camera_covariance[6 * 1 + 5], -3e-5);  // row-major
+  EXPECT_FALSE(msg.base_to_camera_observed[3]);
   const VectorMap back = FromVectorMapMsg(msg);
   EXPECT_EQ(back.frame_id, "odom");
+  EXPECT_EQ(back.T_base_cam_covariance, map.T_base_cam_covariance);
+  EXPECT_EQ(back.T_base_cam_observed, map.T_base_cam_observed);
   ASSERT_EQ(back.markings.size(), 1u);
   EXPECT_EQ(back.markings[0].id, 11u);
   EXPECT_EQ(back.markings[0].class_name, "arrow_straight");

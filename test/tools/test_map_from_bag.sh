@@ -305,6 +305,32 @@ else
   fail "unwritable --stats-out: exit $rc: $(cat "$work/stderr")"
 fi
 
+# 9. --calibration-out: the refined extrinsic as a config the next run starts from (on the
+# bag without /tf_static, whose extrinsic then comes from that file alone).
+if run_mapper --bag "$work/drive.bag" --out "$work/cal" --calibration-out "$work/calibration.yaml" \
+    >"$work/cal.log" 2>&1 &&
+   grep -q "^calibration: sigma roll pitch yaw .* observed: " "$work/cal/summary.txt" &&
+   grep -q "static_transform_publisher" "$work/calibration.yaml" &&
+   grep -q "<joint name=" "$work/calibration.yaml" &&
+   run_mapper --bag "$work/no_tf.bag" --config "$work/calibration.yaml" --out "$work/cal2" \
+    >/dev/null 2>&1 &&
+   grep -q "^extrinsic: config input.extrinsic" "$work/cal2/summary.txt" &&
+   /usr/bin/python3 - "$work/cal/map.json" "$work/cal2/map.json" <<'EOF'
+import json, sys
+first, second = (json.load(open(p)) for p in sys.argv[1:3])
+# The second run started from the first one's refined extrinsic.
+a, b = first["T_base_cam"], second["T_base_cam_initial"]
+assert max(abs(x - y) for x, y in zip(a["t"], b["t"])) < 1e-6, (a, b)
+assert max(abs(abs(x) - abs(y)) for x, y in zip(a["q_xyzw"], b["q_xyzw"])) < 1e-6, (a, b)
+cal = first["T_base_cam_calibration"]
+assert len(cal["covariance"]) == 36 and len(cal["observed"]) == 6, cal
+EOF
+then
+  pass "--calibration-out round-trips into the next run's input.extrinsic"
+else
+  fail "--calibration-out: $(tail -3 "$work/cal.log")"
+fi
+
 if [ "$failures" -ne 0 ]; then
   echo "$failures check(s) failed"
   exit 1

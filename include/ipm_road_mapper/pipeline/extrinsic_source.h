@@ -5,6 +5,7 @@
 #pragma once
 
 #include <Eigen/Geometry>
+#include <array>
 #include <functional>
 #include <string>
 
@@ -29,5 +30,27 @@ struct ExtrinsicChoice {
 std::string ChooseExtrinsic(const InputOptions& input, const std::string& camera_frame,
                             const TransformLookup& lookup, const std::string& lookup_name,
                             ExtrinsicChoice* choice);
+
+// The refined extrinsic as a calibration for the next run (map_from_bag --calibration-out):
+// a YAML config overlay whose input.extrinsic (xyz, rpy_deg) LoadInputOptions reads back,
+// with `base:` set to base_config when it is not empty (so the file is a complete config:
+// that config with the refined extrinsic), and in comments the 1-sigma uncertainty and the
+// observed axes, the covariance, a tf2_ros static_transform_publisher line and a URDF joint.
+struct Calibration {
+  Eigen::Isometry3d T_base_cam = Eigen::Isometry3d::Identity();
+  // roll, pitch, yaw about base_link (rad), x, y, z (m); see VectorMap::T_base_cam_covariance.
+  Eigen::Matrix<double, 6, 6> covariance = Eigen::Matrix<double, 6, 6>::Zero();
+  std::array<bool, 6> observed{};
+  std::string base_frame = "base_link";
+  std::string camera_frame = "camera_optical_frame";
+  std::string note;  // one line on where it came from (bag, config)
+};
+
+// The file's text (see above).
+std::string CalibrationYaml(const Calibration& calibration, const std::string& base_config);
+
+// Writes it atomically; empty on success, else one line why not.
+std::string WriteCalibrationFile(const std::string& path, const Calibration& calibration,
+                                 const std::string& base_config);
 
 }  // namespace ipm_road_mapper

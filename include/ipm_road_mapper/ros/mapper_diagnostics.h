@@ -60,6 +60,9 @@ struct MapperStatusSnapshot {
   BackendStats backend;
   Eigen::Isometry3d T_base_cam_initial = Eigen::Isometry3d::Identity();
   Eigen::Isometry3d T_base_cam = Eigen::Isometry3d::Identity();
+  // Its covariance (roll, pitch, yaw in rad, x, y, z in m) and the axes the data observed.
+  Eigen::Matrix<double, 6, 6> T_base_cam_covariance = Eigen::Matrix<double, 6, 6>::Zero();
+  std::array<bool, 6> extrinsic_observed{};
   std::uint64_t callbacks = 0;                                       // data callbacks timed
   double callback_mean_ms = 0.0, callback_max_ms = 0.0;              // every data callback
   double frame_callback_mean_ms = 0.0, frame_callback_max_ms = 0.0;  // mask + camera_info ones

@@ -103,6 +103,15 @@ BackendOptions LoadBackendOptions(OptionsReader reader) {
   reader.Read<double>("max_extrinsic_change_deg", &max_change_deg, CheckPositive);
   o.max_extrinsic_change_rad = max_change_deg * kDegToRad;
   reader.Read<double>("max_extrinsic_change_m", &o.max_extrinsic_change_m, CheckPositive);
+  reader.Read<double>("extrinsic_min_information_ratio", &o.extrinsic_min_information_ratio,
+                      CheckNonNegative);
+  reader.Read<double>(
+      "extrinsic_prior_memory_markings", &o.extrinsic_prior_memory_markings, [](const double& v) {
+        return v == 0.0 || (std::isfinite(v) && v >= 1.0) ? "" : "must be 0 or >= 1";
+      });
+  reader.Read<int>("extrinsic_holdout_every_n_frames", &o.extrinsic_holdout_every_n_frames,
+                   [](const int& v) { return v == 0 || v >= 2 ? "" : "must be 0 or >= 2"; });
+  reader.Read<double>("extrinsic_holdout_sigmas", &o.extrinsic_holdout_sigmas, CheckNonNegative);
   reader.Read<int>("max_lane_points_per_observation", &o.max_lane_points_per_observation,
                    CheckPositiveInt);
   reader.Read<double>("max_lane_pixel_distance_m", &o.max_lane_pixel_distance_m, CheckPositive);
@@ -168,6 +177,10 @@ std::string ToString(const BackendOptions& o) {
     << k << "pose_prior_sigma_rot_deg: " << Triple(o.pose_prior_sigma_rot_rad, kDegToRad) << "\n"
     << k << "max_extrinsic_change_deg: " << o.max_extrinsic_change_rad / kDegToRad << "\n"
     << k << "max_extrinsic_change_m: " << o.max_extrinsic_change_m << "\n"
+    << k << "extrinsic_min_information_ratio: " << o.extrinsic_min_information_ratio << "\n"
+    << k << "extrinsic_prior_memory_markings: " << o.extrinsic_prior_memory_markings << "\n"
+    << k << "extrinsic_holdout_every_n_frames: " << o.extrinsic_holdout_every_n_frames << "\n"
+    << k << "extrinsic_holdout_sigmas: " << o.extrinsic_holdout_sigmas << "\n"
     << k << "max_lane_points_per_observation: " << o.max_lane_points_per_observation << "\n"
     << k << "max_lane_pixel_distance_m: " << o.max_lane_pixel_distance_m << "\n"
     << k << "max_outside_image_px: " << o.max_outside_image_px << "\n"

@@ -1,6 +1,7 @@
 #include "ipm_road_mapper/core/backend/extrinsic_prior.h"
 
 #include <Eigen/Eigenvalues>
+#include <algorithm>
 
 #include "ipm_road_mapper/core/geometry/rigid_transform.h"
 
@@ -8,15 +9,22 @@ namespace ipm_road_mapper {
 
 ExtrinsicPrior::ExtrinsicPrior(const Eigen::Isometry3d& T_base_cam_0,
                                const Eigen::Vector3d& sigma_rot_rad,
-                               const Eigen::Vector3d& sigma_trans_m)
-    : q0_(Eigen::Quaterniond(T_base_cam_0.linear()).normalized()), t0_(T_base_cam_0.translation()) {
+                               const Eigen::Vector3d& sigma_trans_m, double memory_factors)
+    : q0_(Eigen::Quaterniond(T_base_cam_0.linear()).normalized()),
+      t0_(T_base_cam_0.translation()),
+      memory_factors_(memory_factors) {
   for (int i = 0; i < 3; ++i) {
-    H_(i, i) = 1.0 / (sigma_rot_rad(i) * sigma_rot_rad(i));
-    H_(3 + i, 3 + i) = 1.0 / (sigma_trans_m(i) * sigma_trans_m(i));
+    H_mount_(i, i) = 1.0 / (sigma_rot_rad(i) * sigma_rot_rad(i));
+    H_mount_(3 + i, 3 + i) = 1.0 / (sigma_trans_m(i) * sigma_trans_m(i));
   }
 }
 
 void ExtrinsicPrior::Add(const ExtrinsicFactor& factor) {
+  if (memory_factors_ > 0.0) {
+    const double lambda = std::max(0.0, 1.0 - 1.0 / memory_factors_);
+    H_ *= lambda;
+    b_ *= lambda;
+  }
   // 1/2 (d - l)^T H (d - l) + g^T (d - l) = 1/2 d^T H d + (g - H l)^T d + const.
   H_ += factor.H;
   b_ += factor.g - factor.H * factor.delta_lin;
@@ -37,12 +45,12 @@ Eigen::Isometry3d ExtrinsicPrior::FromDelta(const Eigen::Matrix<double, 6, 1>& d
   return T;
 }
 
-Eigen::Matrix<double, 6, 1> ExtrinsicPrior::MeanDelta() const { return H_.ldlt().solve(-b_); }
+Eigen::Matrix<double, 6, 1> ExtrinsicPrior::MeanDelta() const { return H().ldlt().solve(-b_); }
 
 Eigen::Matrix<double, 6, 6> ExtrinsicPrior::SqrtInformation() const {
   // H = V diag(lambda) V^T -> L = diag(sqrt(lambda)) V^T, so L^T L = H (also for a
   // semi-definite H, where a Cholesky factor would not exist).
-  const Eigen::SelfAdjointEigenSolver<Eigen::Matrix<double, 6, 6>> eigen(H_);
+  const Eigen::SelfAdjointEigenSolver<Eigen::Matrix<double, 6, 6>> eigen(H());
   const Eigen::Matrix<double, 6, 1> roots = eigen.eigenvalues().cwiseMax(0.0).cwiseSqrt();
   return roots.asDiagonal() * eigen.eigenvectors().transpose();
 }

@@ -7,7 +7,9 @@
 #include <cmath>
 #include <limits>
 #include <map>
+#include <optional>
 
+#include "ipm_road_mapper/core/backend/extrinsic_observability.h"
 #include "ipm_road_mapper/core/backend/residuals/along_lane_anchor_residual.h"
 #include "ipm_road_mapper/core/backend/residuals/corner_reprojection_residual.h"
 #include "ipm_road_mapper/core/backend/residuals/extrinsic_prior_residual.h"
@@ -76,11 +78,21 @@ struct WindowState {
   std::vector<LanePixel> lane_pixels;
   std::vector<Eigen::Isometry3d> poses;  // the frames' poses at the start (road surface)
   double step_time_limit_s = std::numeric_limits<double>::infinity();  // of the next step
+  // The extrinsic guard (BackendOptions::extrinsic_holdout_every_n_frames): the frames whose
+  // measurements the map step leaves out while `hold_out` is set, and whether the
+  // extrinsic is held at its value (the guard's reference fit, or after a rejection).
+  std::vector<bool> held_out;
+  bool hold_out = false;
+  bool extrinsic_frozen = false;
+  // What the last map step with the extrinsic free found about it.
+  ExtrinsicObservability observability;
+  bool observability_valid = false;
   explicit WindowState(const WindowSnapshot& s) : extrinsic(s.T_base_cam) {
     for (std::size_t i = 0; i < s.frames.size(); ++i) {
       frames.emplace_back(s.frames[i].T_map_base);
       poses.push_back(s.frames[i].T_map_base);
       slot_of_frame[s.frames[i].index] = i;
+      held_out.push_back(false);
     }
     for (const WindowMarking& m : s.markings) corners.push_back(m.corners_map);
     for (const WindowLane& l : s.lanes) control_points.push_back(l.control_points_map);
@@ -234,58 +246,12 @@ ceres::Solver::Summary Solve(const BackendOptions& options, double time_limit_s,
   return summary;
 }
 
-// The map + extrinsic step: marking corners, lane control points and the extrinsic free,
-// the window's poses data (which also fixes the gauge: the map hangs on the poses).
-ceres::Solver::Summary MapStep(const WindowSnapshot& snapshot, const BackendOptions& options,
-                               WindowState* state, int* blocks) {
-  ceres::Problem problem;
-  ceres::LossFunction* loss = MakeLoss(options);
-  const PinholeCamera camera(snapshot.camera);
-  double* q_bc = state->extrinsic.q;
-  double* t_bc = state->extrinsic.t;
-  *blocks = 0;
-  // The poses are data here, but uncertain: their sigma joins the pixels' (pose_uncertainty.h).
-  const Eigen::Isometry3d T_base_cam = state->extrinsic.ToIsometry();
-  const Eigen::Vector3d sigma_t =
-      options.map_step_pose_sigma_scale * options.pose_prior_sigma_trans_m;
-  const Eigen::Vector3d sigma_r =
-      options.map_step_pose_sigma_scale * options.pose_prior_sigma_rot_rad;
-  auto whitening = [&](std::size_t slot, const Eigen::Vector3d& p_map) {
-    return residuals::PoseUncertaintyWhitening(camera, state->poses[slot], T_base_cam, p_map,
-                                               options.pixel_sigma_px, sigma_t, sigma_r);
-  };
-  if (options.optimize_markings) {
-    for (const CornerMeasurement& m : state->corner_measurements) {
-      const PoseBlocks& pose = state->frames[m.slot];
-      auto& corner = state->corners[m.marking][m.corner];
-      problem.AddResidualBlock(residuals::CornerReprojectionMapStepResidual::Create(
-                                   camera, m.uv, whitening(m.slot, corner), pose.q, pose.t),
-                               loss, corner.data(), q_bc, t_bc);
-      ++*blocks;
-    }
-  }
-  for (const LanePixel& px : state->lane_pixels) {
-    auto& cps = state->control_points[px.lane];
-    const PoseBlocks& pose = state->frames[px.slot];
-    if (options.lane_residual == LaneResidual::kPpsr) {
-      problem.AddResidualBlock(
-          residuals::PpsrMapStepResidual::Create(
-              camera, px.uv, whitening(px.slot, cps[px.segment + 1]), pose.q, pose.t),
-          loss, cps[px.segment + 1].data(), cps[px.segment + 2].data(), q_bc, t_bc);
-      ++*blocks;
-    } else if (options.lane_residual == LaneResidual::kPsr) {
-      problem.AddResidualBlock(residuals::PsrResidual::Create(px.q_map, px.u, options.psr_sigma_m),
-                               loss, cps[px.segment].data(), cps[px.segment + 1].data(),
-                               cps[px.segment + 2].data(), cps[px.segment + 3].data());
-      ++*blocks;
-    }
-  }
-  if (*blocks == 0) {
-    delete loss;
-    return ceres::Solver::Summary();
-  }
-  // Map points: on the road surface (softly), z optionally held; control points anchored
-  // along their lane (PPSR leaves that direction free: a gauge of each point).
+// The priors of the free map points (what makes them well posed besides the measurements):
+// on the road surface (softly), z optionally held; control points anchored along their lane
+// (PPSR leaves that direction free: a gauge of each point) and smooth.
+void AddMapPointPriors(const BackendOptions& options, WindowState* state,
+                       ceres::Problem* problem_ptr) {
+  ceres::Problem& problem = *problem_ptr;
   for (auto& corners : state->corners) {
     for (auto& c : corners) {
       if (!problem.HasParameterBlock(c.data())) continue;
@@ -320,18 +286,136 @@ ceres::Solver::Summary MapStep(const WindowSnapshot& snapshot, const BackendOpti
       ConfigurePoint(options, c.data(), &problem);
     }
   }
+}
+
+// Weight of the hold on an unobserved direction, in whitened units (times the mounting
+// prior's information): the direction stays within 1 % of a prior sigma of its start value.
+constexpr double kUnobservedHoldWeight = 1e4;
+
+// The observability-aware update (extrinsic_observability.h): each direction the solve's
+// data does not observe (ObserveExtrinsic) is held at the window's starting extrinsic.
+void HoldUnobservedDirections(const WindowSnapshot& snapshot, const WindowState& state,
+                              ceres::Problem* problem) {
+  if (!state.observability_valid || state.observability.rank == 6) return;
+  const Eigen::Quaterniond q0 = Eigen::Quaterniond(snapshot.T_base_cam.linear()).normalized();
+  problem->AddResidualBlock(
+      residuals::ExtrinsicPriorResidual::Create(
+          q0, snapshot.T_base_cam.translation(),
+          state.observability.UnobservedHoldSqrtInformation(kUnobservedHoldWeight),
+          Vector6d::Zero()),
+      nullptr, const_cast<double*>(state.extrinsic.q), const_cast<double*>(state.extrinsic.t));
+}
+
+// Which of a state's measurements a problem gets.
+enum class Measurements { kTraining, kHeldOut, kAll };
+
+// Adds the corner and lane-pixel residuals of the map step (pixel sigma and pose uncertainty,
+// pose_uncertainty.h; poses as data) for the chosen measurements; returns how many.
+int AddMapStepMeasurements(const WindowSnapshot& snapshot, const BackendOptions& options,
+                           Measurements which, ceres::LossFunction* loss, WindowState* state,
+                           ceres::Problem* problem) {
+  const PinholeCamera camera(snapshot.camera);
+  double* q_bc = state->extrinsic.q;
+  double* t_bc = state->extrinsic.t;
+  int blocks = 0;
+  auto wanted = [&](std::size_t slot) {
+    return which == Measurements::kAll ||
+           (which == Measurements::kHeldOut) == state->held_out[slot];
+  };
+  // The poses are data here, but uncertain: their sigma joins the pixels' (pose_uncertainty.h).
+  const Eigen::Isometry3d T_base_cam = state->extrinsic.ToIsometry();
+  const Eigen::Vector3d sigma_t =
+      options.map_step_pose_sigma_scale * options.pose_prior_sigma_trans_m;
+  const Eigen::Vector3d sigma_r =
+      options.map_step_pose_sigma_scale * options.pose_prior_sigma_rot_rad;
+  auto whitening = [&](std::size_t slot, const Eigen::Vector3d& p_map) {
+    return residuals::PoseUncertaintyWhitening(camera, state->poses[slot], T_base_cam, p_map,
+                                               options.pixel_sigma_px, sigma_t, sigma_r);
+  };
+  if (options.optimize_markings) {
+    for (const CornerMeasurement& m : state->corner_measurements) {
+      if (!wanted(m.slot)) continue;
+      const PoseBlocks& pose = state->frames[m.slot];
+      auto& corner = state->corners[m.marking][m.corner];
+      problem->AddResidualBlock(residuals::CornerReprojectionMapStepResidual::Create(
+                                    camera, m.uv, whitening(m.slot, corner), pose.q, pose.t),
+                                loss, corner.data(), q_bc, t_bc);
+      ++blocks;
+    }
+  }
+  for (const LanePixel& px : state->lane_pixels) {
+    if (!wanted(px.slot)) continue;
+    auto& cps = state->control_points[px.lane];
+    const PoseBlocks& pose = state->frames[px.slot];
+    if (options.lane_residual == LaneResidual::kPpsr) {
+      problem->AddResidualBlock(
+          residuals::PpsrMapStepResidual::Create(
+              camera, px.uv, whitening(px.slot, cps[px.segment + 1]), pose.q, pose.t),
+          loss, cps[px.segment + 1].data(), cps[px.segment + 2].data(), q_bc, t_bc);
+      ++blocks;
+    } else if (options.lane_residual == LaneResidual::kPsr) {
+      problem->AddResidualBlock(residuals::PsrResidual::Create(px.q_map, px.u, options.psr_sigma_m),
+                                loss, cps[px.segment].data(), cps[px.segment + 1].data(),
+                                cps[px.segment + 2].data(), cps[px.segment + 3].data());
+      ++blocks;
+    }
+  }
+  return blocks;
+}
+
+// The map + extrinsic step: marking corners, lane control points and the extrinsic free,
+// the window's poses data (which also fixes the gauge: the map hangs on the poses).
+ceres::Solver::Summary MapStep(const WindowSnapshot& snapshot, const BackendOptions& options,
+                               WindowState* state, int* blocks) {
+  ceres::Problem problem;
+  ceres::LossFunction* loss = MakeLoss(options);
+  double* q_bc = state->extrinsic.q;
+  double* t_bc = state->extrinsic.t;
+  *blocks = AddMapStepMeasurements(snapshot, options,
+                                   state->hold_out ? Measurements::kTraining : Measurements::kAll,
+                                   loss, state, &problem);
+  if (*blocks == 0) {
+    delete loss;
+    return ceres::Solver::Summary();
+  }
+  AddMapPointPriors(options, state, &problem);
   // The extrinsic: the prior of the retired data and the mounting (counted there once),
-  // rotation on the quaternion manifold; held when not optimized.
+  // rotation on the quaternion manifold; held when not optimized, and in the directions the
+  // data does not observe.
   if (problem.HasParameterBlock(q_bc)) {
     problem.AddResidualBlock(residuals::ExtrinsicPriorResidual::Create(snapshot.extrinsic_prior),
                              nullptr, q_bc, t_bc);
     problem.SetManifold(q_bc, new ceres::EigenQuaternionManifold);
-    if (!options.optimize_extrinsic) {
+    if (!options.optimize_extrinsic || state->extrinsic_frozen) {
       problem.SetParameterBlockConstant(q_bc);
       problem.SetParameterBlockConstant(t_bc);
+    } else {
+      HoldUnobservedDirections(snapshot, *state, &problem);
     }
   }
   return Solve(options, state->step_time_limit_s, &problem);
+}
+
+// The total robustified cost of the held-out measurements at the state's map, extrinsic and
+// poses: the evidence the guard judges an extrinsic by.
+// (Per held-out measurement, in the order they were added: the same order for any state of
+// one snapshot.)
+std::vector<double> HeldOutCosts(const WindowSnapshot& snapshot, const BackendOptions& options,
+                                 WindowState* state) {
+  ceres::Problem problem;
+  ceres::LossFunction* loss = MakeLoss(options);
+  const int blocks =
+      AddMapStepMeasurements(snapshot, options, Measurements::kHeldOut, loss, state, &problem);
+  if (blocks == 0) delete loss;  // the problem owns it only through a residual block
+  std::vector<ceres::ResidualBlockId> ids;
+  problem.GetResidualBlocks(&ids);
+  std::vector<double> costs;
+  for (ceres::ResidualBlockId id : ids) {
+    double cost = 0.0;
+    problem.EvaluateResidualBlock(id, true, &cost, nullptr, nullptr);
+    costs.push_back(cost);
+  }
+  return costs;
 }
 
 // The pose-update step: the window's poses free with their odometry priors; map and
@@ -405,6 +489,140 @@ ceres::Solver::Summary PoseStep(const WindowSnapshot& snapshot, const BackendOpt
   return Solve(options, state->step_time_limit_s, &problem);
 }
 
+// What the solve's data observes of the extrinsic (extrinsic_observability.h), at the
+// state's start: the information of its map-step measurements (the held-out ones excluded)
+// with the map points and the window's poses marginalized, each pose on its odometry and
+// under the motion prior as in the pose step (context frames are data). Marginalizing the
+// poses matters: the map step takes them as data, and a direction of the extrinsic that a
+// pose error explains as well (the camera's yaw against the heading, with noisy odometry)
+// is not observed.
+void ObserveExtrinsic(const WindowSnapshot& snapshot, const BackendOptions& options,
+                      WindowState* state) {
+  ceres::Problem problem;
+  ceres::LossFunction* loss = MakeLoss(options);
+  const PinholeCamera camera(snapshot.camera);
+  double* q_bc = state->extrinsic.q;
+  double* t_bc = state->extrinsic.t;
+  int blocks = 0;
+  auto wanted = [&](std::size_t slot) { return !(state->hold_out && state->held_out[slot]); };
+  if (options.optimize_markings) {
+    for (const CornerMeasurement& m : state->corner_measurements) {
+      if (!wanted(m.slot)) continue;
+      PoseBlocks& pose = state->frames[m.slot];
+      problem.AddResidualBlock(
+          residuals::CornerReprojectionResidual::Create(camera, m.uv, options.pixel_sigma_px), loss,
+          state->corners[m.marking][m.corner].data(), pose.q, pose.t, q_bc, t_bc);
+      ++blocks;
+    }
+  }
+  if (options.lane_residual == LaneResidual::kPpsr) {
+    for (const LanePixel& px : state->lane_pixels) {
+      if (!wanted(px.slot)) continue;
+      auto& cps = state->control_points[px.lane];
+      PoseBlocks& pose = state->frames[px.slot];
+      problem.AddResidualBlock(
+          residuals::PpsrResidual::Create(camera, px.uv, options.pixel_sigma_px), loss,
+          cps[px.segment + 1].data(), cps[px.segment + 2].data(), pose.q, pose.t, q_bc, t_bc);
+      ++blocks;
+    }
+  }
+  if (blocks == 0) {
+    delete loss;
+    return;
+  }
+  AddMapPointPriors(options, state, &problem);
+  for (std::size_t i = 0; i < state->frames.size(); ++i) {
+    PoseBlocks& pose = state->frames[i];
+    if (!problem.HasParameterBlock(pose.q)) continue;
+    problem.SetManifold(pose.q, new ceres::EigenQuaternionManifold);
+    if (!snapshot.frames[i].in_window) {
+      problem.SetParameterBlockConstant(pose.q);
+      problem.SetParameterBlockConstant(pose.t);
+      continue;
+    }
+    problem.AddResidualBlock(
+        residuals::PosePriorResidual::Create(snapshot.frames[i].T_map_base_odom,
+                                             options.pose_prior_sigma_trans_m,
+                                             options.pose_prior_sigma_rot_rad),
+        nullptr, pose.q, pose.t);
+  }
+  if (options.motion_prior) {
+    for (std::size_t i = 1; i + 1 < state->frames.size(); ++i) {
+      const WindowFrame& a = snapshot.frames[i - 1];
+      const WindowFrame& b = snapshot.frames[i];
+      const WindowFrame& c = snapshot.frames[i + 1];
+      if (b.index != a.index + 1 || c.index != b.index + 1 || !b.in_window) continue;
+      if (!problem.HasParameterBlock(state->frames[i - 1].q) ||
+          !problem.HasParameterBlock(state->frames[i].q) ||
+          !problem.HasParameterBlock(state->frames[i + 1].q)) {
+        continue;
+      }
+      const double dt_a = b.stamp - a.stamp, dt_b = c.stamp - b.stamp;
+      if (!(dt_a > 0.0) || !(dt_b > 0.0)) continue;
+      PoseBlocks &pa = state->frames[i - 1], &pb = state->frames[i], &pc = state->frames[i + 1];
+      problem.AddResidualBlock(
+          residuals::MotionPriorResidual::Create(dt_a, dt_b, options.motion_sigma_acc_mps2,
+                                                 options.motion_sigma_angular_acc_radps2),
+          nullptr, pa.q, pa.t, pb.q, pb.t, pc.q, pc.t);
+    }
+  }
+  problem.SetManifold(q_bc, new ceres::EigenQuaternionManifold);
+  state->observability = AnalyzeObservability(
+      ExtrinsicInformation(&problem, q_bc, t_bc, {}),
+      PriorSigma(options.rotation_prior_sigma_rad, options.translation_prior_sigma_m),
+      options.extrinsic_min_information_ratio);
+  state->observability_valid = true;
+}
+
+// The guard against harm, after the first map step (the poses still the snapshot's): the
+// refined extrinsic is kept unless it explains the held-out frames' measurements worse
+// than the starting one (beyond their noise), each with the map re-fit to the training
+// frames. Otherwise the
+// state becomes the reference fit and the extrinsic stays held for the rest of the solve.
+// Nothing is judged when no direction was updated.
+void JudgeExtrinsic(const WindowSnapshot& snapshot, const BackendOptions& options,
+                    double time_limit_s, WindowState* state, WindowState* reference,
+                    WindowResult* result) {
+  state->hold_out = false;  // the later steps use every measurement
+  if (!state->observability_valid || state->observability.rank == 0) return;
+  const std::vector<double> candidate = HeldOutCosts(snapshot, options, state);
+  reference->step_time_limit_s = time_limit_s;
+  int blocks = 0;
+  MapStep(snapshot, options, reference, &blocks);
+  const std::vector<double> held = HeldOutCosts(snapshot, options, reference);
+  if (candidate.size() != held.size()) return;  // cannot happen: one snapshot, one order
+  // The difference of the costs and its spread over the measurements: worse beyond
+  // extrinsic_holdout_sigmas of that spread (an update that changes little moves the costs
+  // both ways by chance, and must not be refused by a coin flip) keeps the start.
+  double difference = 0.0, spread = 0.0;
+  for (std::size_t i = 0; i < held.size(); ++i) {
+    const double d = candidate[i] - held[i];
+    result->holdout_cost_candidate += candidate[i];
+    result->holdout_cost_reference += held[i];
+    difference += d;
+    spread += d * d;
+  }
+  result->holdout_blocks = static_cast<int>(held.size());
+  if (difference <= options.extrinsic_holdout_sigmas * std::sqrt(spread)) return;
+  result->extrinsic_rejected = true;
+  *state = std::move(*reference);
+  state->hold_out = false;
+  state->extrinsic_frozen = true;
+}
+
+// The extrinsic's calibration after the solve: which directions its data observed and the
+// covariance of the prior plus that observed information.
+void FillCalibration(const WindowSnapshot& snapshot, const WindowState& state,
+                     WindowResult* result) {
+  Matrix6d information = snapshot.extrinsic_prior.H();
+  if (state.observability_valid && !state.extrinsic_frozen) {
+    information += state.observability.ObservedInformation();
+    result->extrinsic_observed = state.observability.axis_observed;
+    result->extrinsic_observed_rank = state.observability.rank;
+  }
+  result->T_base_cam_covariance = information.inverse();
+}
+
 }  // namespace
 
 WindowResult SolveWindow(const WindowSnapshot& snapshot, const BackendOptions& options,
@@ -436,10 +654,29 @@ WindowResult SolveWindow(const WindowSnapshot& snapshot, const BackendOptions& o
     result.final_cost = summary.final_cost;
     if (map_step || !usable) result.summary = summary.BriefReport();
   };
+  // The guard: the first map step leaves every N-th frame out; a reference fit of the map
+  // with the extrinsic held at its start value is made from the same start.
+  const bool guard = options.optimize_extrinsic && options.extrinsic_holdout_every_n_frames > 0;
+  std::optional<WindowState> reference;
+  if (guard) {
+    const std::size_t n = static_cast<std::size_t>(options.extrinsic_holdout_every_n_frames);
+    for (std::size_t i = 0; i < snapshot.frames.size(); ++i) {
+      state.held_out[i] = snapshot.frames[i].index % n == n - 1;
+    }
+    state.hold_out = true;
+    reference = state;
+    reference->extrinsic_frozen = true;
+  }
+  if (options.optimize_extrinsic) ObserveExtrinsic(snapshot, options, &state);
   for (int round = 0; round < options.rounds && usable; ++round) {
     run(true);
+    if (round == 0 && guard && usable) {
+      JudgeExtrinsic(snapshot, options, remaining_s(), &state, &*reference, &result);
+      reference.reset();
+    }
     if (usable && options.pose_update) run(false);
   }
+  FillCalibration(snapshot, state, &result);
 
   result.T_base_cam = state.extrinsic.ToIsometry();
   result.extrinsic_change_rad = RotationAngleBetween(result.T_base_cam, snapshot.T_base_cam);

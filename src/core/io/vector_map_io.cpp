@@ -126,6 +126,38 @@ GeoOrigin GeoOriginFromJson(const nlohmann::json& j, const std::string& where) {
   return origin;
 }
 
+// The calibration block: {"axes": [...], "covariance": [36, row-major], "observed": [6]}.
+nlohmann::json CalibrationToJson(const VectorMap& map) {
+  nlohmann::json covariance = nlohmann::json::array();
+  for (int r = 0; r < 6; ++r) {
+    for (int c = 0; c < 6; ++c) covariance.push_back(map.T_base_cam_covariance(r, c));
+  }
+  nlohmann::json observed = nlohmann::json::array();
+  for (bool o : map.T_base_cam_observed) observed.push_back(o);
+  return {{"axes", {"roll", "pitch", "yaw", "x", "y", "z"}},
+          {"covariance", covariance},
+          {"observed", observed}};
+}
+
+void CalibrationFromJson(const nlohmann::json& j, VectorMap* map) {
+  const std::string where = "T_base_cam_calibration";
+  if (!j.is_object()) Fail(where, "expected an object");
+  const nlohmann::json& covariance =
+      json_io::ReadArray(Member(j, "covariance", where), Key(where, "covariance"), 36);
+  if (covariance.size() != 36) Fail(Key(where, "covariance"), "expected 36 numbers");
+  for (int i = 0; i < 36; ++i) {
+    map->T_base_cam_covariance(i / 6, i % 6) =
+        json_io::ReadNumber(covariance[i], Index(Key(where, "covariance"), i));
+  }
+  const nlohmann::json& observed =
+      json_io::ReadArray(Member(j, "observed", where), Key(where, "observed"), 6);
+  if (observed.size() != 6) Fail(Key(where, "observed"), "expected 6 booleans");
+  for (int i = 0; i < 6; ++i) {
+    if (!observed[i].is_boolean()) Fail(Index(Key(where, "observed"), i), "expected a boolean");
+    map->T_base_cam_observed[i] = observed[i].get<bool>();
+  }
+}
+
 }  // namespace
 
 nlohmann::json VectorMapToJson(const VectorMap& map) {
@@ -144,6 +176,7 @@ nlohmann::json VectorMapToJson(const VectorMap& map) {
                       {"frame_id", map.frame_id},
                       {"T_base_cam", PoseToJson(map.T_base_cam)},
                       {"T_base_cam_initial", PoseToJson(map.T_base_cam_initial)},
+                      {"T_base_cam_calibration", CalibrationToJson(map)},
                       {"markings", markings},
                       {"lanes", lanes},
                       {"trajectory", trajectory},
@@ -159,6 +192,8 @@ VectorMap VectorMapFromJson(const nlohmann::json& j) {
   map.T_base_cam = json_io::ReadPose(Member(j, "T_base_cam", ""), "T_base_cam");
   map.T_base_cam_initial =
       json_io::ReadPose(Member(j, "T_base_cam_initial", ""), "T_base_cam_initial");
+  // Optional: maps written before it have none (zero covariance, nothing observed).
+  if (j.contains("T_base_cam_calibration")) CalibrationFromJson(j["T_base_cam_calibration"], &map);
 
   std::set<std::uint64_t> marking_ids;
   const nlohmann::json& markings =

@@ -122,6 +122,8 @@ VectorMap Mapper::ExportMap(const ExportOptions& export_options) const {
   VectorMap out;
   out.T_base_cam = windows_.T_base_cam();
   out.T_base_cam_initial = T_base_cam_initial_;
+  out.T_base_cam_covariance = windows_.T_base_cam_covariance();
+  out.T_base_cam_observed = windows_.extrinsic_observed();
   auto class_name = [this](int class_id) {
     const ClassInfo* info = classes_.Find(class_id);
     return info ? info->name : std::string("class_") + std::to_string(class_id);
@@ -177,6 +179,7 @@ VectorMap Mapper::ExportMap(const ExportOptions& export_options) const {
   out.metadata["backend"] = windows_.enabled() ? ToString(options_.backend.lane_residual) : "off";
   out.metadata["backend_results_applied"] = counters_.results_applied;
   out.metadata["backend_results_rejected"] = counters_.results_rejected;
+  out.metadata["backend_extrinsic_rejected"] = counters_.extrinsic_rejected;
   out.metadata["frontend_time_p50_ms"] = Quantile(frontend_timing_.total_ms, 0.5);
   out.metadata["frontend_time_p95_ms"] = Quantile(frontend_timing_.total_ms, 0.95);
   out.metadata["frontend_extraction_p50_ms"] = Quantile(frontend_timing_.extraction_ms, 0.5);

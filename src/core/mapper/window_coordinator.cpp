@@ -70,7 +70,9 @@ WindowCoordinator::WindowCoordinator(const MapperOptions& options,
       store_(store),
       counters_(counters),
       extrinsic_prior_(T_base_cam_initial, options.backend.rotation_prior_sigma_rad,
-                       options.backend.translation_prior_sigma_m) {
+                       options.backend.translation_prior_sigma_m,
+                       options.backend.extrinsic_prior_memory_markings) {
+  covariance_ = extrinsic_prior_.H().inverse();
   if (options_.backend.enabled) backend_ = std::make_unique<Backend>(options_.backend);
 }
 
@@ -311,6 +313,12 @@ void WindowCoordinator::ApplyResults() {
 
 void WindowCoordinator::ApplyResult(const WindowResult& result, bool include_retired) {
   T_base_cam_ = result.T_base_cam;  // fed forward to the next frames' IPM
+  if (result.extrinsic_rejected) {
+    ++counters_->extrinsic_rejected;  // T_base_cam is the previous one; so is what is known
+  } else {
+    covariance_ = result.T_base_cam_covariance;
+    for (int i = 0; i < 6; ++i) observed_[i] = observed_[i] || result.extrinsic_observed[i];
+  }
   for (const WindowFrame& f : result.frames) {
     if (f.in_window && f.index < store_->frames().size()) {
       store_->SetFramePose(f.index, f.T_map_base);

@@ -8,7 +8,14 @@
 // its information here (extrinsic_marginalization.h: its points marginalized by the Schur
 // complement), and each window's map step adds this prior instead of starting afresh. The
 // mounting prior (t_0 of the paper, and a loose hold on the mounting angles) is the first
-// term, so it is counted once.
+// term, so it is counted once, and it is never forgotten.
+//
+// Bounded memory: the retired information is a marginal that forgets. Each Add first scales
+// what is there by lambda = 1 - 1 / memory_factors (exponential forgetting, Kalman-style),
+// so the prior holds about the last memory_factors batches: a batch linearized early, at the
+// rough extrinsic and with poses it had not yet corrected, fades instead of locking its bias
+// in (a plain sum made the x/y lever arm wander 3-4 cm on most drives). memory_factors <= 0:
+// no forgetting (a plain sum).
 #pragma once
 
 #include <Eigen/Cholesky>
@@ -31,9 +38,9 @@ class ExtrinsicPrior {
   // Centered on T_base_cam_0 (the rough extrinsic) with per-axis sigmas of the rotation
   // (base_link roll, pitch, yaw, rad) and the translation (m): the mounting prior.
   ExtrinsicPrior(const Eigen::Isometry3d& T_base_cam_0, const Eigen::Vector3d& sigma_rot_rad,
-                 const Eigen::Vector3d& sigma_trans_m);
+                 const Eigen::Vector3d& sigma_trans_m, double memory_factors = 0.0);
 
-  // Adds a batch's information.
+  // Forgets (see the file comment), then adds a batch's information.
   void Add(const ExtrinsicFactor& factor);
 
   // delta of an extrinsic, and the extrinsic of a delta (around q0, t0).
@@ -46,15 +53,20 @@ class ExtrinsicPrior {
 
   const Eigen::Quaterniond& q0() const { return q0_; }
   const Eigen::Vector3d& t0() const { return t0_; }
-  const Eigen::Matrix<double, 6, 6>& H() const { return H_; }
+  // The whole information (mounting + retired) and the mounting part alone.
+  Eigen::Matrix<double, 6, 6> H() const { return H_mount_ + H_; }
+  const Eigen::Matrix<double, 6, 6>& H_mount() const { return H_mount_; }
   int factors() const { return factors_; }
+  double memory_factors() const { return memory_factors_; }
 
  private:
   Eigen::Quaterniond q0_ = Eigen::Quaterniond::Identity();
   Eigen::Vector3d t0_ = Eigen::Vector3d::Zero();
-  Eigen::Matrix<double, 6, 6> H_ = Eigen::Matrix<double, 6, 6>::Zero();
+  Eigen::Matrix<double, 6, 6> H_mount_ = Eigen::Matrix<double, 6, 6>::Zero();  // mean: delta 0
+  Eigen::Matrix<double, 6, 6> H_ = Eigen::Matrix<double, 6, 6>::Zero();        // retired batches
   Eigen::Matrix<double, 6, 1> b_ = Eigen::Matrix<double, 6, 1>::Zero();
   int factors_ = 0;
+  double memory_factors_ = 0.0;
 };
 
 }  // namespace ipm_road_mapper

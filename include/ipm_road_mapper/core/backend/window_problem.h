@@ -82,6 +82,17 @@ struct WindowResult {
   std::vector<WindowLane> lanes;        // measurements left empty
   double extrinsic_change_rad = 0.0;
   double extrinsic_change_m = 0.0;
+  // The extrinsic's calibration (extrinsic_observability.h): the covariance of T_base_cam
+  // in the prior's chart (roll, pitch, yaw about base_link in rad, then x, y, z in m) and
+  // which of those axes this solve's data observed (the others were held).
+  Eigen::Matrix<double, 6, 6> T_base_cam_covariance = Eigen::Matrix<double, 6, 6>::Zero();
+  std::array<bool, 6> extrinsic_observed{};
+  int extrinsic_observed_rank = 0;  // observed eigen-directions
+  // The guard: the refined extrinsic explained the held-out frames worse than the starting
+  // one (their robustified costs below), so the starting one was kept.
+  bool extrinsic_rejected = false;
+  double holdout_cost_candidate = 0.0, holdout_cost_reference = 0.0;
+  int holdout_blocks = 0;
   double solve_time_s = 0.0;
   int residual_blocks = 0;
   int iterations = 0;

@@ -63,6 +63,12 @@ struct VectorMap {
   std::vector<MapLane> lanes;
   Eigen::Isometry3d T_base_cam = Eigen::Isometry3d::Identity();          // refined
   Eigen::Isometry3d T_base_cam_initial = Eigen::Isometry3d::Identity();  // as handed in
+  // The refined extrinsic's calibration. Covariance over (roll, pitch, yaw, x, y, z): the
+  // rotation error as a rotation vector about base_link's axes (R_true = Exp(e) R, rad),
+  // then the translation (m). Observed: whether the data observed that axis (the others
+  // stayed at their prior, extrinsic_observability.h).
+  Eigen::Matrix<double, 6, 6> T_base_cam_covariance = Eigen::Matrix<double, 6, 6>::Zero();
+  std::array<bool, 6> T_base_cam_observed{};
   std::vector<StampedPose> trajectory;                 // corrected T_map_base per processed frame
   nlohmann::json metadata = nlohmann::json::object();  // method, config, counters, origin
   std::optional<GeoOrigin> geo_origin;                 // when the map frame is geo-referenced

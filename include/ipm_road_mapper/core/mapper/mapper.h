@@ -89,6 +89,12 @@ class Mapper {
   // The extrinsic the front end uses now: the refined one once the back end has a result.
   const Eigen::Isometry3d& T_base_cam() const { return windows_.T_base_cam(); }
   const Eigen::Isometry3d& T_base_cam_initial() const { return T_base_cam_initial_; }
+  // The refined extrinsic's covariance (roll, pitch, yaw about base_link in rad, x, y, z in
+  // m) and the axes the data has observed (window_coordinator.h).
+  const Eigen::Matrix<double, 6, 6>& T_base_cam_covariance() const {
+    return windows_.T_base_cam_covariance();
+  }
+  const std::array<bool, 6>& extrinsic_observed() const { return windows_.extrinsic_observed(); }
 
  private:
   // Why an input cannot be used.

@@ -29,6 +29,9 @@ struct MapperCounters {
   std::uint64_t lane_observations_near_lane = 0;
   std::uint64_t results_applied = 0;   // back-end results merged into the map
   std::uint64_t results_rejected = 0;  // unusable (solver failure, trust bound)
+  // Applied results whose refined extrinsic the guard refused (it explained the held-out
+  // frames worse than the previous one, which was kept; window_problem.h).
+  std::uint64_t extrinsic_rejected = 0;
   std::uint64_t SkippedTotal() const;
 };
 

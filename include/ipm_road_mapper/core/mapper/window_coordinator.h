@@ -8,6 +8,7 @@
 #pragma once
 
 #include <Eigen/Geometry>
+#include <array>
 #include <cstdint>
 #include <limits>
 #include <memory>
@@ -51,6 +52,10 @@ class WindowCoordinator {
 
   // The extrinsic the front end uses: the rough one until a result refines it.
   const Eigen::Isometry3d& T_base_cam() const { return T_base_cam_; }
+  // Its covariance (roll, pitch, yaw about base_link in rad, x, y, z in m; the mounting
+  // prior's until a result refines it) and the axes the data has observed.
+  const Eigen::Matrix<double, 6, 6>& T_base_cam_covariance() const { return covariance_; }
+  const std::array<bool, 6>& extrinsic_observed() const { return observed_; }
   BackendStats stats() const;
   // The camera of the last used frame (the snapshots', and the export re-fit's).
   const CameraIntrinsics& camera() const { return camera_; }
@@ -78,6 +83,8 @@ class WindowCoordinator {
   CameraIntrinsics camera_;  // of the last used frame
   std::uint64_t next_sequence_ = 1;
   ExtrinsicPrior extrinsic_prior_;  // the mounting prior plus everything retired
+  Eigen::Matrix<double, 6, 6> covariance_;
+  std::array<bool, 6> observed_{};
   std::unique_ptr<Backend> backend_;
 };
 

@@ -4,6 +4,8 @@
 // with L^T L = H, so 1/2 |r|^2 equals the prior's cost up to a constant. Log is the exact
 // rotation vector (ceres::QuaternionToAngleAxis, safe for autodiff near the identity), the
 // same chart the marginalization differentiates in.
+// The same form with any L and mean holds chosen directions of the extrinsic
+// (extrinsic_observability.h: the unobserved ones, pinned at the window's start value).
 // Parameter blocks: q_base_cam[4] (Eigen x, y, z, w), t_base_cam[3].
 #pragma once
 
@@ -24,6 +26,11 @@ class ExtrinsicPriorResidual {
         t0_(prior.t0()),
         L_(prior.SqrtInformation()),
         mean_(prior.MeanDelta()) {}
+  // r = L (delta(q, t) - mean) in the chart around (q0, t0).
+  ExtrinsicPriorResidual(const Eigen::Quaterniond& q0, const Eigen::Vector3d& t0,
+                         const Eigen::Matrix<double, 6, 6>& L,
+                         const Eigen::Matrix<double, 6, 1>& mean)
+      : q0_inv_(q0.conjugate()), t0_(t0), L_(L), mean_(mean) {}
 
   template <typename T>
   bool operator()(const T* const q_base_cam, const T* const t_base_cam, T* residual) const {
@@ -41,6 +48,12 @@ class ExtrinsicPriorResidual {
   static ceres::CostFunction* Create(const ExtrinsicPrior& prior) {
     return new ceres::AutoDiffCostFunction<ExtrinsicPriorResidual, 6, 4, 3>(
         new ExtrinsicPriorResidual(prior));
+  }
+  static ceres::CostFunction* Create(const Eigen::Quaterniond& q0, const Eigen::Vector3d& t0,
+                                     const Eigen::Matrix<double, 6, 6>& L,
+                                     const Eigen::Matrix<double, 6, 1>& mean) {
+    return new ceres::AutoDiffCostFunction<ExtrinsicPriorResidual, 6, 4, 3>(
+        new ExtrinsicPriorResidual(q0, t0, L, mean));
   }
 
  private:
