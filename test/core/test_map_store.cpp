@@ -131,6 +131,30 @@ TEST(MapStore, PruningKeepsCountsAndTheRecentMeasurements) {
   EXPECT_EQ(store.markings()[0].Observations(), 10u);
 }
 
+TEST(MapStore, TheCorrectionOfAFrameIsCarriedToTheFramesAfterIt) {
+  MapStore store(4.0);
+  for (int i = 0; i < 5; ++i) store.AddFrame(i, Pose(2.0 * i, 0.1 * i, 0.0, 0.0, 0.0, 0.01 * i));
+  EXPECT_TRUE(store.T_map_odom().isApprox(Eigen::Isometry3d::Identity()));
+  // A solve moved frame 2 (a shift and a turn) but not 3 and 4.
+  const Eigen::Isometry3d T_map_odom = Pose(0.3, -0.2, 0.01, 0.0, 0.0, 0.02);
+  store.SetFramePose(2, T_map_odom * store.frames()[2].T_map_base_odom);
+  store.CorrectFramesAfter(2);
+  EXPECT_TRUE(store.T_map_odom().isApprox(T_map_odom, 1e-12));
+  EXPECT_TRUE(store.frames()[1].T_map_base.isApprox(store.frames()[1].T_map_base_odom));
+  for (std::size_t i = 3; i < 5; ++i) {
+    EXPECT_TRUE(store.frames()[i].T_map_base.isApprox(
+        T_map_odom * store.frames()[i].T_map_base_odom, 1e-12));
+  }
+  // A new frame starts from the correction; its odometry stays the raw one.
+  const FrameRecord& added = store.AddFrame(5.0, Pose(10.0, 0.5, 0.0, 0.0, 0.0, 0.05));
+  EXPECT_TRUE(added.T_map_base_odom.isApprox(Pose(10.0, 0.5, 0.0, 0.0, 0.0, 0.05)));
+  EXPECT_TRUE(added.T_map_base.isApprox(T_map_odom * added.T_map_base_odom, 1e-12));
+  // The road-surface index follows the corrected positions.
+  EXPECT_LT(store.RoadSurfaceAt(added.T_map_base.translation()).distance_m, 1e-9);
+  store.Clear();
+  EXPECT_TRUE(store.T_map_odom().isApprox(Eigen::Isometry3d::Identity()));
+}
+
 TEST(MapStore, ClearDropsEverythingButIdsStayUnique) {
   MapStore store(4.0);
   store.AddFrame(1.0, Eigen::Isometry3d::Identity());

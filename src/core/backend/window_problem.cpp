@@ -75,6 +75,9 @@ struct WindowState {
   std::vector<CornerMeasurement> corner_measurements;
   std::vector<LanePixel> lane_pixels;
   std::vector<Eigen::Isometry3d> poses;  // the frames' poses at the start (road surface)
+  std::vector<bool> optimized;           // free in a pose step (WindowFrame::optimized)
+  int covariance_slot = -1;              // the newest optimized frame after the last pose step
+  PoseCovariance covariance = PoseCovariance::Zero();                  // of that frame's pose
   double step_time_limit_s = std::numeric_limits<double>::infinity();  // of the next step
   explicit WindowState(const WindowSnapshot& s) : extrinsic(s.T_base_cam) {
     for (std::size_t i = 0; i < s.frames.size(); ++i) {
@@ -82,6 +85,7 @@ struct WindowState {
       poses.push_back(s.frames[i].T_map_base);
       slot_of_frame[s.frames[i].index] = i;
     }
+    optimized.assign(s.frames.size(), false);
     for (const WindowMarking& m : s.markings) corners.push_back(m.corners_map);
     for (const WindowLane& l : s.lanes) control_points.push_back(l.control_points_map);
   }
@@ -334,6 +338,23 @@ ceres::Solver::Summary MapStep(const WindowSnapshot& snapshot, const BackendOpti
   return Solve(options, state->step_time_limit_s, &problem);
 }
 
+// After a pose step: which window frames it moved, and the covariance of the newest of them
+// (what the mapper carries forward to the frames that follow it).
+void RecordPoseStep(const WindowSnapshot& snapshot, ceres::Problem* problem, WindowState* state) {
+  state->covariance_slot = -1;
+  for (std::size_t i = 0; i < state->frames.size(); ++i) {
+    const PoseBlocks& pose = state->frames[i];
+    if (!snapshot.frames[i].in_window || !problem->HasParameterBlock(pose.q)) continue;
+    state->optimized[i] = true;
+    state->covariance_slot = static_cast<int>(i);  // frames are sorted by index
+  }
+  if (state->covariance_slot < 0 || !snapshot.newest_pose_covariance) return;
+  const PoseBlocks& newest = state->frames[state->covariance_slot];
+  if (!ComputePoseCovariance(problem, newest.q, newest.t, &state->covariance)) {
+    state->covariance_slot = -1;
+  }
+}
+
 // The pose-update step: the window's poses free with their odometry priors; map and
 // extrinsic data (the gauge is fixed by the map).
 ceres::Solver::Summary PoseStep(const WindowSnapshot& snapshot, const BackendOptions& options,
@@ -402,7 +423,9 @@ ceres::Solver::Summary PoseStep(const WindowSnapshot& snapshot, const BackendOpt
         nullptr, pose.q, pose.t);
     problem.SetManifold(pose.q, new ceres::EigenQuaternionManifold);
   }
-  return Solve(options, state->step_time_limit_s, &problem);
+  const ceres::Solver::Summary summary = Solve(options, state->step_time_limit_s, &problem);
+  if (summary.IsSolutionUsable()) RecordPoseStep(snapshot, &problem, state);
+  return summary;
 }
 
 }  // namespace
@@ -457,7 +480,13 @@ WindowResult SolveWindow(const WindowSnapshot& snapshot, const BackendOptions& o
   for (std::size_t i = 0; i < snapshot.frames.size(); ++i) {
     WindowFrame frame = snapshot.frames[i];
     frame.T_map_base = state.frames[i].ToIsometry();
+    frame.optimized = state.optimized[i];
     result.frames.push_back(frame);
+  }
+  if (state.covariance_slot >= 0) {
+    result.covariance_frame =
+        static_cast<std::int64_t>(snapshot.frames[state.covariance_slot].index);
+    result.T_map_base_covariance = state.covariance;
   }
   for (std::size_t m = 0; m < snapshot.markings.size(); ++m) {
     result.markings.push_back({snapshot.markings[m].id, state.corners[m], {}});

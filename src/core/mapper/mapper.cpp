@@ -101,6 +101,13 @@ FrameStatus Mapper::ProcessFrame(const FrameInput& input, std::string* reason) {
   return FrameStatus::kUsed;
 }
 
+std::optional<PoseEstimate> Mapper::NewestPose() const {
+  const std::vector<FrameRecord>& frames = store_.frames();
+  if (frames.empty()) return std::nullopt;
+  const FrameRecord& newest = frames.back();
+  return PoseEstimate{newest.stamp, newest.T_map_base, windows_.PoseCovarianceOf(newest.index)};
+}
+
 void Mapper::PruneHistories() {
   // Every kPruneEveryFrames frames, so that the erasures are batched.
   constexpr std::size_t kPruneEveryFrames = 100;

@@ -86,7 +86,19 @@ BackendStats WindowCoordinator::stats() const {
   return backend_ ? backend_->stats() : BackendStats();
 }
 
+PoseCovariance WindowCoordinator::PoseCovarianceOf(std::size_t index) const {
+  const BackendOptions& o = options_.backend;
+  const FrameRecord& frame = store_->frames()[index];
+  const PoseCovariance odometry = OdometryPoseCovariance(
+      frame.T_map_base, o.pose_prior_sigma_trans_m, o.pose_prior_sigma_rot_rad);
+  if (covariance_frame_ < 0 || static_cast<std::size_t>(covariance_frame_) > index) return odometry;
+  const std::size_t solved = static_cast<std::size_t>(covariance_frame_);
+  return PropagatePoseCovariance(covariance_, store_->frames()[solved].T_map_base, frame.T_map_base,
+                                 solved == index ? PoseCovariance::Zero() : odometry);
+}
+
 void WindowCoordinator::Reset() {
+  covariance_frame_ = -1;
   if (!backend_) return;
   backend_->Stop();  // results of the old map must not land in the new one
   backend_ = std::make_unique<Backend>(options_.backend);
@@ -183,6 +195,7 @@ void WindowCoordinator::FinalGlobalSolve(double time_budget_s) {
   snapshot.T_base_cam = T_base_cam_;
   snapshot.extrinsic_prior =
       ExtrinsicPrior(T_base_cam_initial_, o.rotation_prior_sigma_rad, o.translation_prior_sigma_m);
+  snapshot.newest_pose_covariance = false;  // the windows' covariance stands
   auto in_span = [start](const auto& measurement) { return measurement.frame_index >= start; };
   std::vector<const MarkingElement*> markings;
   for (const MarkingElement& m : store_->markings()) markings.push_back(&m);
@@ -311,10 +324,23 @@ void WindowCoordinator::ApplyResults() {
 
 void WindowCoordinator::ApplyResult(const WindowResult& result, bool include_retired) {
   T_base_cam_ = result.T_base_cam;  // fed forward to the next frames' IPM
+  // The poses the pose step moved; the others are the snapshot's and may since have been
+  // corrected by a newer result.
+  std::int64_t newest_optimized = -1;
   for (const WindowFrame& f : result.frames) {
-    if (f.in_window && f.index < store_->frames().size()) {
+    if (f.in_window && f.optimized && f.index < store_->frames().size()) {
       store_->SetFramePose(f.index, f.T_map_base);
+      newest_optimized = std::max(newest_optimized, static_cast<std::int64_t>(f.index));
     }
+  }
+  // The newest corrected frame's correction carried along the odometry to the frames after
+  // it (the pose priors stay on the raw odometry: the correction is an initial value and an
+  // output, never a measurement).
+  if (newest_optimized >= 0) store_->CorrectFramesAfter(static_cast<std::size_t>(newest_optimized));
+  if (result.covariance_frame >= 0 &&
+      static_cast<std::size_t>(result.covariance_frame) < store_->frames().size()) {
+    covariance_frame_ = result.covariance_frame;
+    covariance_ = result.T_map_base_covariance;
   }
   if (options_.backend.optimize_markings) {
     std::unordered_map<std::uint64_t, MarkingElement*> by_id;

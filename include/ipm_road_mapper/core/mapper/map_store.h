@@ -22,10 +22,19 @@ class MapStore {
   // `road_plane_radius_m`: the radius of RoadSurfaceAt (backend.road_plane_radius_m).
   explicit MapStore(double road_plane_radius_m);
 
-  // Appends a used frame; its corrected pose starts at the odometry.
+  // Appends a used frame; its corrected pose starts at the odometry carried by the current
+  // correction: T_map_base = T_map_odom() * T_map_base_odom.
   const FrameRecord& AddFrame(double stamp, const Eigen::Isometry3d& T_map_base_odom);
   // Sets frame `index`'s corrected pose (a back-end result).
   void SetFramePose(std::size_t index, const Eigen::Isometry3d& T_map_base);
+  // Takes the correction of frame `index` (its corrected pose times its odometry's inverse)
+  // as the current one, and carries it to every later frame, whose poses no solve has
+  // corrected yet: the newest frames follow the last solve instead of the raw odometry.
+  void CorrectFramesAfter(std::size_t index);
+  // The current correction, T_map_odom: the corrected map frame from the odometry's frame
+  // (identity until a solve corrected a frame). T_map_base of a frame past the last solve is
+  // T_map_odom * T_map_base_odom.
+  const Eigen::Isometry3d& T_map_odom() const { return T_map_odom_; }
   // A fresh element id.
   std::uint64_t NewId() { return map_.next_id++; }
   // Moves the live markings flagged `retired` and last seen before `first_frame` into the
@@ -79,6 +88,7 @@ class MapStore {
   // Retired markings by the grid cell of their center (cells of kRetiredCellM).
   std::unordered_map<CellKey, std::vector<std::size_t>> retired_cells_;
   double max_retired_cov_trace_ = 0.0;
+  Eigen::Isometry3d T_map_odom_ = Eigen::Isometry3d::Identity();
   static constexpr double kRetiredCellM = 10.0;
 };
 

@@ -37,6 +37,14 @@ struct FrameInput {
   Eigen::Isometry3d T_map_base_odom = Eigen::Isometry3d::Identity();  // odometry at stamp
 };
 
+// A corrected vehicle pose with its covariance (pose_covariance.h: x y z, rotation about
+// the map axes), as ~corrected_odom publishes it.
+struct PoseEstimate {
+  double stamp = 0.0;  // s
+  Eigen::Isometry3d T_map_base = Eigen::Isometry3d::Identity();
+  PoseCovariance covariance = PoseCovariance::Zero();
+};
+
 // What happened to a frame.
 enum class FrameStatus { kUsed, kSkipped };
 
@@ -89,6 +97,13 @@ class Mapper {
   // The extrinsic the front end uses now: the refined one once the back end has a result.
   const Eigen::Isometry3d& T_base_cam() const { return windows_.T_base_cam(); }
   const Eigen::Isometry3d& T_base_cam_initial() const { return T_base_cam_initial_; }
+  // The newest used frame's corrected pose: the last solve's correction carried along the
+  // odometry (T_map_odom() * its odometry) until a solve reaches it; nullopt before a frame.
+  std::optional<PoseEstimate> NewestPose() const;
+  // The correction of the odometry, T_map_odom (REP-105 map -> odom): identity until a
+  // solve corrected a frame; then T_map_base_opt * T_odom_base_opt^-1 of the newest frame
+  // the last solve moved. T_map_odom() * odometry = the corrected pose of a new frame.
+  const Eigen::Isometry3d& T_map_odom() const { return store_.T_map_odom(); }
 
  private:
   // Why an input cannot be used.

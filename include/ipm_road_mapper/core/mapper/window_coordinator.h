@@ -52,6 +52,11 @@ class WindowCoordinator {
   // The extrinsic the front end uses: the rough one until a result refines it.
   const Eigen::Isometry3d& T_base_cam() const { return T_base_cam_; }
   BackendStats stats() const;
+  // The covariance of frame `index`'s corrected pose (pose_covariance.h): the last solve's
+  // covariance of its newest optimized frame carried along the odometry to it, plus the
+  // frame's own odometry noise (backend.pose_prior_sigma_*) when no solve has reached it;
+  // that noise alone before the first solve or without a back end.
+  PoseCovariance PoseCovarianceOf(std::size_t index) const;
   // The camera of the last used frame (the snapshots', and the export re-fit's).
   const CameraIntrinsics& camera() const { return camera_; }
 
@@ -77,7 +82,9 @@ class WindowCoordinator {
   MapperCounters* counters_;
   CameraIntrinsics camera_;  // of the last used frame
   std::uint64_t next_sequence_ = 1;
-  ExtrinsicPrior extrinsic_prior_;  // the mounting prior plus everything retired
+  ExtrinsicPrior extrinsic_prior_;      // the mounting prior plus everything retired
+  std::int64_t covariance_frame_ = -1;  // the frame of covariance_ (-1: none yet)
+  PoseCovariance covariance_ = PoseCovariance::Zero();
   std::unique_ptr<Backend> backend_;
 };
 
