@@ -17,7 +17,7 @@ const FrameRecord& MapStore::AddFrame(double stamp, const Eigen::Isometry3d& T_m
   frame.index = map_.frames.size();
   frame.stamp = stamp;
   frame.T_map_base_odom = T_map_base_odom;
-  frame.T_map_base = T_map_odom_ * T_map_base_odom;
+  frame.T_map_base = T_map_base_odom;
   frame_index_.Set(frame.index, frame.T_map_base.translation());
   map_.frames.push_back(frame);
   return map_.frames.back();
@@ -28,12 +28,16 @@ void MapStore::SetFramePose(std::size_t index, const Eigen::Isometry3d& T_map_ba
   frame_index_.Set(index, T_map_base.translation());
 }
 
-void MapStore::CorrectFramesAfter(std::size_t index) {
+void MapStore::SetCorrectionFrom(std::size_t index) {
   const FrameRecord& frame = map_.frames[index];
   T_map_odom_ = frame.T_map_base * frame.T_map_base_odom.inverse();
-  for (std::size_t i = index + 1; i < map_.frames.size(); ++i) {
-    SetFramePose(i, T_map_odom_ * map_.frames[i].T_map_base_odom);
-  }
+  corrected_frame_ = static_cast<std::int64_t>(index);
+}
+
+Eigen::Isometry3d MapStore::CorrectedPose(std::size_t index) const {
+  const FrameRecord& frame = map_.frames[index];
+  if (static_cast<std::int64_t>(index) <= corrected_frame_) return frame.T_map_base;
+  return T_map_odom_ * frame.T_map_base_odom;
 }
 
 namespace {
@@ -143,6 +147,7 @@ void MapStore::Clear() {
   retired_cells_.clear();
   max_retired_cov_trace_ = 0.0;
   T_map_odom_ = Eigen::Isometry3d::Identity();
+  corrected_frame_ = -1;
 }
 
 Eigen::Vector3d MapStore::RoadDirectionAt(const Eigen::Vector3d& p_map) const {

@@ -105,7 +105,8 @@ std::optional<PoseEstimate> Mapper::NewestPose() const {
   const std::vector<FrameRecord>& frames = store_.frames();
   if (frames.empty()) return std::nullopt;
   const FrameRecord& newest = frames.back();
-  return PoseEstimate{newest.stamp, newest.T_map_base, windows_.PoseCovarianceOf(newest.index)};
+  return PoseEstimate{newest.stamp, store_.CorrectedPose(newest.index),
+                      windows_.PoseCovarianceOf(newest.index)};
 }
 
 void Mapper::PruneHistories() {
@@ -175,7 +176,7 @@ VectorMap Mapper::ExportMap(const ExportOptions& export_options) const {
       max_poses > 0 && frames.size() > max_poses ? frames.size() - max_poses : 0;
   out.trajectory.reserve(frames.size() - first);
   for (std::size_t i = first; i < frames.size(); ++i) {
-    out.trajectory.push_back({frames[i].stamp, frames[i].T_map_base});
+    out.trajectory.push_back({frames[i].stamp, store_.CorrectedPose(i)});
   }
   out.metadata["method"] = options_.method;
   out.metadata["frames_received"] = counters_.frames_received;

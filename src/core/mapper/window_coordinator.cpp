@@ -88,12 +88,12 @@ BackendStats WindowCoordinator::stats() const {
 
 PoseCovariance WindowCoordinator::PoseCovarianceOf(std::size_t index) const {
   const BackendOptions& o = options_.backend;
-  const FrameRecord& frame = store_->frames()[index];
-  const PoseCovariance odometry = OdometryPoseCovariance(
-      frame.T_map_base, o.pose_prior_sigma_trans_m, o.pose_prior_sigma_rot_rad);
+  const Eigen::Isometry3d T_map_base = store_->CorrectedPose(index);
+  const PoseCovariance odometry =
+      OdometryPoseCovariance(T_map_base, o.pose_prior_sigma_trans_m, o.pose_prior_sigma_rot_rad);
   if (covariance_frame_ < 0 || static_cast<std::size_t>(covariance_frame_) > index) return odometry;
   const std::size_t solved = static_cast<std::size_t>(covariance_frame_);
-  return PropagatePoseCovariance(covariance_, store_->frames()[solved].T_map_base, frame.T_map_base,
+  return PropagatePoseCovariance(covariance_, store_->frames()[solved].T_map_base, T_map_base,
                                  solved == index ? PoseCovariance::Zero() : odometry);
 }
 
@@ -333,10 +333,10 @@ void WindowCoordinator::ApplyResult(const WindowResult& result, bool include_ret
       newest_optimized = std::max(newest_optimized, static_cast<std::int64_t>(f.index));
     }
   }
-  // The newest corrected frame's correction carried along the odometry to the frames after
-  // it (the pose priors stay on the raw odometry: the correction is an initial value and an
-  // output, never a measurement).
-  if (newest_optimized >= 0) store_->CorrectFramesAfter(static_cast<std::size_t>(newest_optimized));
+  // The newest corrected frame's correction, carried along the odometry to the frames after
+  // it in the outputs (MapStore::CorrectedPose; the estimator keeps the raw odometry as
+  // their start and prior: the correction is never a measurement).
+  if (newest_optimized >= 0) store_->SetCorrectionFrom(static_cast<std::size_t>(newest_optimized));
   if (result.covariance_frame >= 0 &&
       static_cast<std::size_t>(result.covariance_frame) < store_->frames().size()) {
     covariance_frame_ = result.covariance_frame;
