@@ -6,6 +6,7 @@
 
 #include "ipm_road_mapper/core/frontend/instance_extraction.h"
 #include "ipm_road_mapper/core/geometry/ipm.h"
+#include "ipm_road_mapper/core/mapper/pose_extrapolator.h"
 #include "ipm_road_mapper/core/mapper/timing_series.h"
 
 namespace ipm_road_mapper {
@@ -105,8 +106,16 @@ std::optional<PoseEstimate> Mapper::NewestPose() const {
   const std::vector<FrameRecord>& frames = store_.frames();
   if (frames.empty()) return std::nullopt;
   const FrameRecord& newest = frames.back();
-  return PoseEstimate{newest.stamp, store_.CorrectedPose(newest.index),
-                      windows_.PoseCovarianceOf(newest.index)};
+  PoseEstimate estimate;
+  estimate.stamp = newest.stamp;
+  const std::int64_t solved = store_.corrected_frame();
+  estimate.T_map_base = solved >= 0 && static_cast<std::size_t>(solved) < newest.index
+                            ? ExtrapolateNewestPose(frames, static_cast<std::size_t>(solved),
+                                                    store_.T_map_odom(), options_.backend)
+                            : store_.CorrectedPose(newest.index);
+  estimate.covariance = windows_.PoseCovarianceOf(newest.index);
+  estimate.T_map_odom = estimate.T_map_base * newest.T_map_base_odom.inverse();
+  return estimate;
 }
 
 void Mapper::PruneHistories() {

@@ -34,6 +34,8 @@ class MapStore {
   // The current correction, T_map_odom: the corrected map frame from the odometry's frame
   // (identity until a solve moved a frame).
   const Eigen::Isometry3d& T_map_odom() const { return T_map_odom_; }
+  // The frame T_map_odom() was taken from (-1: none yet).
+  std::int64_t corrected_frame() const { return corrected_frame_; }
   // Frame `index`'s pose as it comes out (~corrected_odom, the exported trajectory): the
   // solved pose, or for a frame after the last solve's newest one the correction carried
   // along its odometry, T_map_odom() * T_map_base_odom. Not an input of the estimator: a

@@ -43,6 +43,9 @@ struct PoseEstimate {
   double stamp = 0.0;  // s
   Eigen::Isometry3d T_map_base = Eigen::Isometry3d::Identity();
   PoseCovariance covariance = PoseCovariance::Zero();
+  // The correction at this frame, T_map_base * T_odom_base^-1 (REP-105 map -> odom): with
+  // the frame's odometry it gives T_map_base.
+  Eigen::Isometry3d T_map_odom = Eigen::Isometry3d::Identity();
 };
 
 // What happened to a frame.
@@ -97,8 +100,10 @@ class Mapper {
   // The extrinsic the front end uses now: the refined one once the back end has a result.
   const Eigen::Isometry3d& T_base_cam() const { return windows_.T_base_cam(); }
   const Eigen::Isometry3d& T_base_cam_initial() const { return T_base_cam_initial_; }
-  // The newest used frame's corrected pose: the last solve's correction carried along the
-  // odometry (T_map_odom() * its odometry) until a solve reaches it; nullopt before a frame.
+  // The newest used frame's corrected pose: until a solve reaches it, the solved trajectory
+  // continued over the frames since with the motion and odometry priors
+  // (pose_extrapolator.h; T_map_odom() * its odometry when that cannot run); nullopt before
+  // a frame.
   std::optional<PoseEstimate> NewestPose() const;
   // The correction of the odometry, T_map_odom (REP-105 map -> odom): identity until a
   // solve corrected a frame; then T_map_base_opt * T_odom_base_opt^-1 of the newest frame
