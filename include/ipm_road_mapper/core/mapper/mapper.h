@@ -107,7 +107,9 @@ class Mapper {
   std::optional<PoseEstimate> NewestPose() const;
   // The correction of the odometry, T_map_odom (REP-105 map -> odom): identity until a
   // solve corrected a frame; then T_map_base_opt * T_odom_base_opt^-1 of the newest frame
-  // the last solve moved. T_map_odom() * odometry = the corrected pose of a new frame.
+  // the last solve moved; T_map_odom() * odometry is a later frame's carried pose
+  // (MapStore::CorrectedPose, the exported trajectory). The correction at the newest frame,
+  // what the nodelet broadcasts, is NewestPose()->T_map_odom.
   const Eigen::Isometry3d& T_map_odom() const { return store_.T_map_odom(); }
 
  private:
