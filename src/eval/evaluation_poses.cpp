@@ -125,6 +125,12 @@ PoseMetrics EvaluatePoses(const VectorMap& map, const GroundTruth& gt,
   }
 
   std::vector<double> trans, rot, yaw, trans_input, rot_input, yaw_input;
+  std::vector<double> along, across, along_input, across_input;
+  // The translation error in the true base_link axes: x along the heading, y across it.
+  auto in_base = [](const Eigen::Isometry3d& T_est, const Eigen::Isometry3d& T_true) {
+    return Eigen::Vector3d(T_true.linear().transpose() *
+                           (T_est.translation() - T_true.translation()));
+  };
   for (const auto& [frame_index, pose] : pairs) {
     const GroundTruthFrame& frame = gt.frames[frame_index];
     PoseFrameError e;
@@ -137,6 +143,9 @@ PoseMetrics EvaluatePoses(const VectorMap& map, const GroundTruth& gt,
     trans_input.push_back(e.trans_err_m_input);
     rot_input.push_back(e.rot_err_deg_input);
     yaw_input.push_back(e.yaw_err_deg_input);
+    const Eigen::Vector3d e_input = in_base(frame.T_map_base_odom, frame.T_map_base_true);
+    along_input.push_back(std::abs(e_input.x()));
+    across_input.push_back(std::abs(e_input.y()));
     if (pose == nullptr) {
       e.trans_err_m = e.rot_err_deg = e.yaw_err_deg = kNoValue;
     } else {
@@ -146,6 +155,9 @@ PoseMetrics EvaluatePoses(const VectorMap& map, const GroundTruth& gt,
       trans.push_back(e.trans_err_m);
       rot.push_back(e.rot_err_deg);
       yaw.push_back(e.yaw_err_deg);
+      const Eigen::Vector3d e_base = in_base(pose->T_map_base, frame.T_map_base_true);
+      along.push_back(std::abs(e_base.x()));
+      across.push_back(std::abs(e_base.y()));
     }
     metrics.frames.push_back(e);
   }
@@ -156,6 +168,10 @@ PoseMetrics EvaluatePoses(const VectorMap& map, const GroundTruth& gt,
   metrics.trans_err_m_input = Summarize(std::move(trans_input));
   metrics.rot_err_deg_input = Summarize(std::move(rot_input));
   metrics.yaw_err_deg_input = Summarize(std::move(yaw_input));
+  metrics.along_err_m = Summarize(std::move(along));
+  metrics.across_err_m = Summarize(std::move(across));
+  metrics.along_err_m_input = Summarize(std::move(along_input));
+  metrics.across_err_m_input = Summarize(std::move(across_input));
   return metrics;
 }
 

@@ -147,6 +147,10 @@ void AddPoses(const PoseMetrics& m, nlohmann::json* j) {
   (*j)["pose_rot_err_deg_input"] = Number(m.rot_err_deg_input.mean);
   (*j)["pose_yaw_err_deg_input"] = Number(m.yaw_err_deg_input.mean);
   (*j)["pose_trans_err_max_m_input"] = Number(m.trans_err_m_input.max);
+  (*j)["pose_along_err_m"] = Number(m.along_err_m.mean);
+  (*j)["pose_across_err_m"] = Number(m.across_err_m.mean);
+  (*j)["pose_along_err_m_input"] = Number(m.along_err_m_input.mean);
+  (*j)["pose_across_err_m_input"] = Number(m.across_err_m_input.mean);
   nlohmann::json frames = nlohmann::json::array();
   for (const PoseFrameError& e : m.frames) {
     frames.push_back({{"stamp", e.stamp},

@@ -124,6 +124,10 @@ void AddPoseRows(const Metrics& metrics, Table* t) {
          "m");
   t->Row("translation error max", Fixed(p.trans_err_m.max, 3), Fixed(p.trans_err_m_input.max, 3),
          "m");
+  t->Row("  along the heading", Fixed(p.along_err_m.mean, 3), Fixed(p.along_err_m_input.mean, 3),
+         "m");
+  t->Row("  across the heading", Fixed(p.across_err_m.mean, 3), Fixed(p.across_err_m_input.mean, 3),
+         "m");
   t->Row("rotation error mean", Fixed(p.rot_err_deg.mean, 3), Fixed(p.rot_err_deg_input.mean, 3),
          "deg");
   t->Row("yaw error mean", Fixed(p.yaw_err_deg.mean, 3), Fixed(p.yaw_err_deg_input.mean, 3), "deg");

@@ -23,6 +23,10 @@ std::string CheckFrameName(const std::string& v) {
 
 std::string CheckNonEmpty(const std::string& v) { return v.empty() ? "must not be empty" : ""; }
 
+std::string CheckFrameNameSet(const std::string& v) {
+  return v.empty() ? "must not be empty" : CheckFrameName(v);
+}
+
 }  // namespace
 
 RosOptions LoadRosOptions(OptionsReader reader) {
@@ -37,7 +41,13 @@ RosOptions LoadRosOptions(OptionsReader reader) {
   reader.Read<double>("publish_rate_hz", &o.publish_rate_hz, [](const double& v) {
     return v > 0.0 && v <= 100.0 ? "" : "must be in (0, 100] Hz";
   });
-  reader.Read<std::string>("map_frame", &o.map_frame, CheckFrameName);
+  reader.Read<std::string>("map_frame", &o.map_frame, CheckFrameNameSet);
+  reader.Read<std::string>("odom_frame", &o.odom_frame, CheckFrameNameSet);
+  reader.Read<bool>("publish_map_to_odom", &o.publish_map_to_odom);
+  if (o.map_frame == o.odom_frame) {
+    throw OptionsError(reader.KeyPath("odom_frame") + ": must differ from map_frame (" +
+                       o.map_frame + "): map -> odom would be a frame's parent of itself");
+  }
   reader.Read<std::string>("refined_camera_frame", &o.refined_camera_frame, CheckFrameName);
   reader.Read<std::string>("save_map_path", &o.save_map_path);
   reader.Read<std::string>("classes_file", &o.classes_file);
@@ -95,7 +105,9 @@ std::string ToString(const RosOptions& o) {
     << "ros.odom_topic: " << o.odom_topic << "\n"
     << "ros.sync: " << o.sync << "\n"
     << "ros.publish_rate_hz: " << o.publish_rate_hz << "\n"
-    << "ros.map_frame: " << or_default(o.map_frame, "(odometry header.frame_id)") << "\n"
+    << "ros.map_frame: " << o.map_frame << "\n"
+    << "ros.odom_frame: " << o.odom_frame << "\n"
+    << "ros.publish_map_to_odom: " << (o.publish_map_to_odom ? "true" : "false") << "\n"
     << "ros.refined_camera_frame: " << or_default(o.refined_camera_frame, "(<camera>_refined)")
     << "\n"
     << "ros.save_map_path: " << or_default(o.save_map_path, "(none: not saved at shutdown)") << "\n"

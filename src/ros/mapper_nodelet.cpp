@@ -95,7 +95,7 @@ void MapperNodelet::SetUpOutputs() {
   output_nh.setCallbackQueue(&output_queue_);
   map_publisher_ = std::make_unique<MapPublisher>(private_nh, config_.ros.path_max_poses,
                                                   config_.ros.marker_full_period_s);
-  corrected_odom_pub_ = private_nh.advertise<nav_msgs::Odometry>("corrected_odom", 10);
+  pose_publisher_ = std::make_unique<PosePublisher>(private_nh, config_.ros.publish_map_to_odom);
   debug_image_ = std::make_unique<DebugImagePublisher>(
       nh, private_nh, config_.ros.image_topic, config_.mapper, classes_,
       [this](const sensor_msgs::ImageConstPtr& image) { OnImage(image); });
@@ -200,12 +200,7 @@ void MapperNodelet::RecordCallbackTime(std::chrono::steady_clock::time_point sta
 }
 
 void MapperNodelet::AfterUpdate(const SessionUpdate& update, const FrameOutputs& outputs) {
-  nav_msgs::Odometry odom;
-  odom.header.stamp = FromSeconds(update.used.back().stamp);
-  odom.header.frame_id = outputs.map_frame;
-  odom.child_frame_id = outputs.base_frame;
-  odom.pose.pose = IsometryToPose(outputs.T_map_base);
-  corrected_odom_pub_.publish(odom);
+  pose_publisher_->Publish(outputs, FromSeconds(update.used.back().stamp));
   if (debug_image_ && outputs.overlay_map) {
     debug_image_->AddFrame(update.used.back(), outputs.T_map_base, outputs.T_base_cam,
                            outputs.overlay_map);
@@ -329,6 +324,7 @@ void MapperNodelet::Shutdown() {
   diagnostics_.reset();
   debug_image_.reset();
   map_publisher_.reset();
+  pose_publisher_.reset();
 }
 
 void MapperNodelet::SaveAtShutdown(std::chrono::steady_clock::time_point deadline) {

@@ -196,10 +196,15 @@ void MappingWorker::HandleFrame(FrameItem& frame) {
 }
 
 void MappingWorker::HandleOdometry(const OdometryItem& odometry) {
-  if (map_frame_.empty()) {
-    map_frame_ = !config_.ros.map_frame.empty() ? config_.ros.map_frame
-                 : !odometry.frame_id.empty()   ? odometry.frame_id
-                                                : std::string("map");
+  if (!odom_frame_checked_ && !odometry.frame_id.empty()) {
+    odom_frame_checked_ = true;
+    if (odometry.frame_id != config_.ros.odom_frame) {
+      ROS_WARN(
+          "%s: the odometry is in %s, not ros/odom_frame %s: the map -> odom transform "
+          "is broadcast to %s (set ros/odom_frame to the odometry's frame)",
+          node_name_.c_str(), odometry.frame_id.c_str(), config_.ros.odom_frame.c_str(),
+          config_.ros.odom_frame.c_str());
+    }
   }
   SessionUpdate update;
   session_.AddOdometry(odometry.pose, &update);
@@ -245,9 +250,13 @@ void MappingWorker::AfterUpdate(const SessionUpdate& update) {
   newest_frame_stamp_ = update.used.back().stamp;
   const Mapper& mapper = *session_.mapper();
   FrameOutputs outputs;
-  outputs.T_map_base = mapper.map().frames.back().T_map_base;
+  const std::optional<PoseEstimate> newest = mapper.NewestPose();
+  outputs.T_map_base = newest->T_map_base;
+  outputs.T_map_base_covariance = newest->covariance;
+  outputs.T_map_odom = newest->T_map_odom;
   outputs.T_base_cam = mapper.T_base_cam();
-  outputs.map_frame = map_frame_.empty() ? "map" : map_frame_;
+  outputs.map_frame = config_.ros.map_frame;
+  outputs.odom_frame = config_.ros.odom_frame;
   outputs.base_frame = config_.mapper.input.base_frame;
   // The overlay draws the map as of its frame: a fresh snapshot, throttled, only when watched.
   const Clock::time_point now = Clock::now();
@@ -261,7 +270,7 @@ void MappingWorker::AfterUpdate(const SessionUpdate& update) {
 
 std::shared_ptr<VectorMap> MappingWorker::ExportMap() const {
   auto map = std::make_shared<VectorMap>(session_.mapper()->ExportMap());
-  map->frame_id = map_frame_.empty() ? "map" : map_frame_;
+  map->frame_id = config_.ros.map_frame;
   map->metadata["source"] = "ipm_road_mapper/MapperNodelet " + node_name_;
   map->metadata["extrinsic_source"] = extrinsic_status_;
   return map;
@@ -296,7 +305,7 @@ void MappingWorker::Export() {
   snapshot->map_version = map_version_;
   snapshot->resets = generation_;
   snapshot->newest_frame_stamp = newest_frame_stamp_;
-  snapshot->map_frame = map_frame_.empty() ? "map" : map_frame_;
+  snapshot->map_frame = config_.ros.map_frame;
   snapshot->refined_camera_frame = refined_frame_;
   snapshot->status = Status();
   std::shared_ptr<const MapSnapshot> old;

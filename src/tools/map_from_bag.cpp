@@ -350,7 +350,8 @@ int Run(int argc, char** argv) {
   map.metadata["startup_s"] = stats.startup_s ? nlohmann::json(*stats.startup_s) : nullptr;
   // Messages of unreadable chunks and the spans of the bag they covered (docs/map_from_bag.md).
   map.metadata["lost"] = LostSpansToJson(stats.lost, stats.bag_begin_s);
-  map.geo_origin = config.geo_origin;  // recorded in map.json; the GeoJSON needs it
+  map.geo_origin = config.geo_origin;   // recorded in map.json; the GeoJSON needs it
+  map.frame_id = config.ros.map_frame;  // the live nodelet's frame for the same config
   const std::string summary = Summary(args, mapper, session.assembler(), map, stats);
   try {
     if (frame_stats) frame_stats->Close();

@@ -131,6 +131,36 @@ TEST(MapStore, PruningKeepsCountsAndTheRecentMeasurements) {
   EXPECT_EQ(store.markings()[0].Observations(), 10u);
 }
 
+TEST(MapStore, TheCorrectionOfASolvedFrameComesOutOnTheFramesAfterIt) {
+  MapStore store(4.0);
+  for (int i = 0; i < 5; ++i) store.AddFrame(i, Pose(2.0 * i, 0.1 * i, 0.0, 0.0, 0.0, 0.01 * i));
+  EXPECT_TRUE(store.T_map_odom().isApprox(Eigen::Isometry3d::Identity()));
+  EXPECT_TRUE(store.CorrectedPose(4).isApprox(store.frames()[4].T_map_base_odom));
+  // A solve moved frames 1 and 2 (a shift and a turn), the newest it moved is 2.
+  const Eigen::Isometry3d T_map_odom = Pose(0.3, -0.2, 0.01, 0.0, 0.0, 0.02);
+  const Eigen::Isometry3d T_1 = Pose(2.1, 0.0, 0.0, 0.0, 0.0, 0.0);
+  store.SetFramePose(1, T_1);
+  store.SetFramePose(2, T_map_odom * store.frames()[2].T_map_base_odom);
+  store.SetCorrectionFrom(2);
+  EXPECT_TRUE(store.T_map_odom().isApprox(T_map_odom, 1e-12));
+  // Solved frames come out as solved; later ones carry the correction along the odometry.
+  EXPECT_TRUE(store.CorrectedPose(1).isApprox(T_1));
+  EXPECT_TRUE(store.CorrectedPose(0).isApprox(store.frames()[0].T_map_base_odom));
+  for (std::size_t i = 3; i < 5; ++i) {
+    EXPECT_TRUE(
+        store.CorrectedPose(i).isApprox(T_map_odom * store.frames()[i].T_map_base_odom, 1e-12));
+  }
+  // A new frame too; its own pose (the estimator's start) and odometry stay the raw odometry.
+  const FrameRecord& added = store.AddFrame(5.0, Pose(10.0, 0.5, 0.0, 0.0, 0.0, 0.05));
+  EXPECT_TRUE(added.T_map_base_odom.isApprox(Pose(10.0, 0.5, 0.0, 0.0, 0.0, 0.05)));
+  EXPECT_TRUE(added.T_map_base.isApprox(added.T_map_base_odom));
+  EXPECT_TRUE(store.CorrectedPose(5).isApprox(T_map_odom * added.T_map_base_odom, 1e-12));
+  store.Clear();
+  EXPECT_TRUE(store.T_map_odom().isApprox(Eigen::Isometry3d::Identity()));
+  store.AddFrame(9.0, Pose(1.0, 0.0, 0.0, 0.0, 0.0, 0.0));
+  EXPECT_TRUE(store.CorrectedPose(0).isApprox(Pose(1.0, 0.0, 0.0, 0.0, 0.0, 0.0)));
+}
+
 TEST(MapStore, ClearDropsEverythingButIdsStayUnique) {
   MapStore store(4.0);
   store.AddFrame(1.0, Eigen::Isometry3d::Identity());

@@ -72,6 +72,42 @@ TEST(WindowCoordinator, ResultsComeBackIntoTheMap) {
   EXPECT_FALSE(rig.windows.T_base_cam().isApprox(TestExtrinsic(), 1e-12));
 }
 
+// The last solve's correction comes out on the frames after it: a frame added after a solve
+// comes out at the correction times its odometry (not at the raw odometry), the correction
+// is that of the newest frame the solve moved, and the covariance handed out for the new
+// frame is the solved one carried along plus the frame's own odometry noise.
+TEST(WindowCoordinator, FramesAfterASolveComeOutWithItsCorrection) {
+  Rig rig(SynchronousOptions());
+  int k = 0;
+  while (rig.counters.results_applied < 3) {
+    rig.Step(DriftingFrame(k++));
+    rig.windows.ApplyResults();
+  }
+  const Eigen::Isometry3d T_map_odom = rig.store.T_map_odom();
+  EXPECT_FALSE(T_map_odom.isApprox(Eigen::Isometry3d::Identity(), 1e-6));  // it did correct
+  // The correction is that of a solved frame: some frame's pose has exactly it.
+  bool found = false;
+  for (const FrameRecord& f : rig.store.frames()) {
+    if ((f.T_map_base * f.T_map_base_odom.inverse()).isApprox(T_map_odom, 1e-12)) found = true;
+  }
+  EXPECT_TRUE(found);
+  // A frame after the solve comes out with the correction carried along its odometry.
+  ASSERT_FALSE(rig.Step(DriftingFrame(k++)));  // no window submitted: no new correction
+  const FrameRecord& added = rig.store.frames().back();
+  const Eigen::Isometry3d T_out = rig.store.CorrectedPose(added.index);
+  EXPECT_TRUE(T_out.isApprox(T_map_odom * added.T_map_base_odom, 1e-12));
+  EXPECT_FALSE(T_out.isApprox(added.T_map_base_odom, 1e-6));
+  const PoseCovariance covariance = rig.windows.PoseCovarianceOf(added.index);
+  EXPECT_TRUE(covariance.allFinite());
+  EXPECT_TRUE(covariance.isApprox(covariance.transpose(), 1e-9));
+  EXPECT_GT(covariance.ldlt().vectorD().minCoeff(), 0.0);
+  // At least the new frame's own odometry noise (the solved part adds to it).
+  const BackendOptions& o = rig.options.backend;
+  const PoseCovariance odometry =
+      OdometryPoseCovariance(T_out, o.pose_prior_sigma_trans_m, o.pose_prior_sigma_rot_rad);
+  EXPECT_GT((covariance - odometry).diagonal().minCoeff(), 0.0);
+}
+
 // Two identical runs; in the second, the lane gains a control point at its start between a
 // window's submission and the merge of its result. The result must land on the same points
 // (shifted by one), and the new point must stay as it is.

@@ -298,6 +298,18 @@ TEST_F(EvaluationTest, PoseErrorIsTheAppliedShift) {
   EXPECT_NEAR(m.rot_err_deg.mean, 1.0, 1e-9);
   EXPECT_NEAR(m.yaw_err_deg.mean, 1.0, 1e-9);
   EXPECT_NEAR(m.trans_err_m_input.max, std::hypot(0.004 * 59, 0.2), 1e-9);
+  // The split along / across the true heading: the shift in each true base_link's axes.
+  double along = 0.0, across = 0.0;
+  for (const GroundTruthFrame& frame : gt_.frames) {
+    const Eigen::Vector3d e =
+        frame.T_map_base_true.linear().transpose() * Eigen::Vector3d(0.2, -0.1, 0.0);
+    along += std::abs(e.x()) / gt_.frames.size();
+    across += std::abs(e.y()) / gt_.frames.size();
+  }
+  EXPECT_NEAR(m.along_err_m.mean, along, 1e-9);
+  EXPECT_NEAR(m.across_err_m.mean, across, 1e-9);
+  EXPECT_NEAR(std::hypot(m.along_err_m.mean, m.across_err_m.mean), std::hypot(0.2, 0.1), 0.05);
+  EXPECT_LE(m.along_err_m_input.mean, m.trans_err_m_input.mean + 1e-12);
 
   map_.trajectory.clear();
   const Metrics without = EvaluateMap(map_, gt_, options_);

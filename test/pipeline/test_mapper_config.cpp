@@ -56,6 +56,14 @@ TEST(MapperConfig, RosSectionIsTypedAndValidated) {
   EXPECT_NE(ErrorOf("ros: {publish_rate_hz: -1}").find("ros.publish_rate_hz"), std::string::npos);
   EXPECT_NE(ErrorOf("ros: {sync_queue_size: 0}").find("ros.sync_queue_size"), std::string::npos);
   EXPECT_NE(ErrorOf("ros: {map_frame: /map}").find("ros.map_frame"), std::string::npos);
+  // REP-105 frames: both named, distinct (map -> odom is broadcast between them).
+  EXPECT_NE(ErrorOf("ros: {map_frame: ''}").find("ros.map_frame"), std::string::npos);
+  EXPECT_NE(ErrorOf("ros: {odom_frame: map}").find("ros.odom_frame"), std::string::npos);
+  EXPECT_NE(ErrorOf("ros: {publish_map_to_odom: 3}").find("ros.publish_map_to_odom"),
+            std::string::npos);
+  EXPECT_EQ(Load("ros: {sync: exact}").ros.map_frame, "map");
+  EXPECT_EQ(Load("ros: {sync: exact}").ros.odom_frame, "odom");
+  EXPECT_TRUE(Load("ros: {sync: exact}").ros.publish_map_to_odom);
   EXPECT_NE(ErrorOf("ros: {odometry_wait_s: abc}").find("wrong type"), std::string::npos);
   EXPECT_NE(ErrorOf("bogus: 1").find("bogus"), std::string::npos);  // core keys still checked
   EXPECT_NE(ErrorOf("ipm: {max_range_m: -3}").find("ipm.max_range_m"), std::string::npos);

@@ -156,13 +156,13 @@ class MapperBagTest(unittest.TestCase):
         added = {m.ns for m in markers.markers if m.action == Marker.ADD}
         self.assertTrue({"lanes", "lane_control_points", "markings", "marking_labels"} <= added,
                         added)
-        self.assertTrue(all(m.header.frame_id == "odom" for m in markers.markers
+        self.assertTrue(all(m.header.frame_id == "map" for m in markers.markers
                             if m.action == Marker.ADD))
 
     def test_vector_map(self):
         vector_map = self.topics.latest.get("/mapper/vector_map")
         self.assertIsNotNone(vector_map, "no ~vector_map")
-        self.assertEqual(vector_map.header.frame_id, "odom")  # the odometry's frame
+        self.assertEqual(vector_map.header.frame_id, "map")  # ros/map_frame, REP-105
         self.assertGreaterEqual(len(vector_map.markings), 3)
         self.assertGreaterEqual(len(vector_map.lanes), 2)
         for lane in vector_map.lanes:
@@ -185,11 +185,17 @@ class MapperBagTest(unittest.TestCase):
     def test_corrected_path_and_odometry(self):
         path = self.topics.latest.get("/mapper/corrected_path")
         self.assertIsNotNone(path, "no ~corrected_path")
-        self.assertEqual(path.header.frame_id, "odom")
+        self.assertEqual(path.header.frame_id, "map")
         self.assertGreaterEqual(len(path.poses), 0.9 * FRAMES)
         # 8 s at 10 m/s along the first straight.
         self.assertGreater(path.poses[-1].pose.position.x - path.poses[0].pose.position.x, 60.0)
         self.assertGreaterEqual(self.topics.count.get("/mapper/corrected_odom", 0), 0.5 * FRAMES)
+
+    def test_offline_and_live_maps_share_the_frame_id(self):
+        # REP-105: the same bag gives map.json in ros/map_frame ("map") live and offline.
+        for stem in ("live_full", "offline_full", "live_fe", "offline_fe"):
+            with open(os.path.join(self.out, stem, "map.json")) as f:
+                self.assertEqual(json.load(f)["frame_id"], "map", stem)
 
     def test_debug_image(self):
         image = self.topics.latest.get("/mapper/debug_image")

@@ -84,7 +84,9 @@ TEST(MappingWorker, MapsInItsThreadAndPublishesSnapshots) {
   MappingWorker::Hooks hooks;
   hooks.on_update = [&](const SessionUpdate& update, const FrameOutputs& outputs) {
     updates += static_cast<int>(update.used.size());
-    EXPECT_EQ(outputs.map_frame, "odom");
+    // REP-105: the map in ros/map_frame, the odometry's frame is odom (map -> odom).
+    EXPECT_EQ(outputs.map_frame, "map");
+    EXPECT_EQ(outputs.odom_frame, "odom");
   };
   MappingWorker worker(Config(), Classes(), "test", kNoTf, hooks);
   EXPECT_EQ(worker.Latest()->map, nullptr);  // before the first frame
@@ -92,7 +94,7 @@ TEST(MappingWorker, MapsInItsThreadAndPublishesSnapshots) {
   ASSERT_TRUE(WaitForSnapshot(
       worker, [](const MapSnapshot& s) { return s.map && s.status.counters.frames_used == 10; }));
   const auto snapshot = worker.Latest();
-  EXPECT_EQ(snapshot->map->frame_id, "odom");
+  EXPECT_EQ(snapshot->map->frame_id, "map");  // as map_from_bag's map.json
   EXPECT_EQ(snapshot->map->trajectory.size(), 10u);
   EXPECT_EQ(snapshot->refined_camera_frame, "camera_refined");
   EXPECT_NEAR(snapshot->newest_frame_stamp, 0.95, 1e-9);

@@ -166,6 +166,9 @@ struct PoseMetrics {
   int map_poses_unmatched = 0;
   ErrorSummary trans_err_m, rot_err_deg, yaw_err_deg;
   ErrorSummary trans_err_m_input, rot_err_deg_input, yaw_err_deg_input;
+  // |error| along and across the true heading (x, y of the true base_link): slow odometry
+  // drift shows along the road (markings fix it) and across it (lanes fix it) differently.
+  ErrorSummary along_err_m, across_err_m, along_err_m_input, across_err_m_input;
   std::vector<PoseFrameError> frames;
 };
 

@@ -23,8 +23,14 @@ struct RosOptions {
   std::string image_topic = "/camera/image_raw";  // optional ("" = none), debug overlay only
   std::string odom_topic = "/odom";               // nav_msgs/Odometry
   std::string sync = "exact";                     // exact | approximate (mask <-> camera_info)
-  double publish_rate_hz = 2.0;      // ~vector_map, ~markers, ~corrected_path, refined tf
-  std::string map_frame;             // frame of the published map; "" = odometry header.frame_id
+  double publish_rate_hz = 2.0;  // ~vector_map, ~markers, ~corrected_path, refined tf
+  // REP-105 frames, named as robot_localization names them: the map and everything
+  // corrected is in map_frame (also map.json's frame_id, offline and live); the odometry is
+  // in odom_frame; with publish_map_to_odom the nodelet broadcasts map_frame -> odom_frame
+  // (the correction), so that map_frame -> base_link is the corrected pose.
+  std::string map_frame = "map";
+  std::string odom_frame = "odom";
+  bool publish_map_to_odom = true;
   std::string refined_camera_frame;  // tf child of the refined extrinsic; "" = <camera>_refined
   std::string save_map_path;         // the map is written here (autosave, shutdown) when set
   std::string classes_file;          // class table; "" = the package's config/classes.yaml

@@ -53,6 +53,7 @@
 #include "ipm_road_mapper/ros/map_saver.h"
 #include "ipm_road_mapper/ros/mapper_diagnostics.h"
 #include "ipm_road_mapper/ros/mapping_worker.h"
+#include "ipm_road_mapper/ros/pose_publisher.h"
 
 namespace ipm_road_mapper {
 
@@ -124,7 +125,7 @@ class MapperNodelet : public nodelet::Nodelet {
   std::unique_ptr<message_filters::Synchronizer<ExactPolicy>> exact_sync_;
   std::unique_ptr<message_filters::Synchronizer<ApproximatePolicy>> approximate_sync_;
   ros::Subscriber odom_sub_;
-  ros::Publisher corrected_odom_pub_;
+  std::unique_ptr<PosePublisher> pose_publisher_;  // ~corrected_odom, map -> odom
   ros::WallTimer publish_timer_, diagnostics_timer_;
   ros::ServiceServer save_srv_, reset_srv_;
   std::unique_ptr<MapPublisher> map_publisher_;

@@ -43,9 +43,14 @@ struct MapSnapshot {
 
 // What the mapping thread hands the nodelet after a frame was used.
 struct FrameOutputs {
-  Eigen::Isometry3d T_map_base = Eigen::Isometry3d::Identity();  // newest used frame
+  // The newest used frame's corrected pose and its covariance (x y z, rotation about the
+  // map axes: nav_msgs/Odometry's convention), ~corrected_odom.
+  Eigen::Isometry3d T_map_base = Eigen::Isometry3d::Identity();
+  PoseCovariance T_map_base_covariance = PoseCovariance::Zero();
+  // The current correction of the odometry (REP-105 map -> odom).
+  Eigen::Isometry3d T_map_odom = Eigen::Isometry3d::Identity();
   Eigen::Isometry3d T_base_cam = Eigen::Isometry3d::Identity();
-  std::string map_frame, base_frame;
+  std::string map_frame, odom_frame, base_frame;
   std::shared_ptr<const VectorMap> overlay_map;  // set when a debug overlay is due
 };
 
@@ -113,7 +118,8 @@ class MappingWorker {
 
   // Mapping thread only.
   MappingSession session_;
-  std::string camera_frame_, extrinsic_status_, map_frame_;
+  std::string camera_frame_, extrinsic_status_;
+  bool odom_frame_checked_ = false;  // the odometry's frame was compared with ros/odom_frame
   std::string refined_frame_;
   std::uint64_t map_version_ = 0, exported_version_ = 0;
   std::uint64_t generation_ = 0;  // resets run

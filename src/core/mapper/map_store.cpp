@@ -28,6 +28,18 @@ void MapStore::SetFramePose(std::size_t index, const Eigen::Isometry3d& T_map_ba
   frame_index_.Set(index, T_map_base.translation());
 }
 
+void MapStore::SetCorrectionFrom(std::size_t index) {
+  const FrameRecord& frame = map_.frames[index];
+  T_map_odom_ = frame.T_map_base * frame.T_map_base_odom.inverse();
+  corrected_frame_ = static_cast<std::int64_t>(index);
+}
+
+Eigen::Isometry3d MapStore::CorrectedPose(std::size_t index) const {
+  const FrameRecord& frame = map_.frames[index];
+  if (static_cast<std::int64_t>(index) <= corrected_frame_) return frame.T_map_base;
+  return T_map_odom_ * frame.T_map_base_odom;
+}
+
 namespace {
 
 // Erases the measurements of frames before `frame` (histories are sorted by frame).
@@ -134,6 +146,8 @@ void MapStore::Clear() {
   frame_index_.Clear();
   retired_cells_.clear();
   max_retired_cov_trace_ = 0.0;
+  T_map_odom_ = Eigen::Isometry3d::Identity();
+  corrected_frame_ = -1;
 }
 
 Eigen::Vector3d MapStore::RoadDirectionAt(const Eigen::Vector3d& p_map) const {

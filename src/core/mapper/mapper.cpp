@@ -6,6 +6,7 @@
 
 #include "ipm_road_mapper/core/frontend/instance_extraction.h"
 #include "ipm_road_mapper/core/geometry/ipm.h"
+#include "ipm_road_mapper/core/mapper/pose_extrapolator.h"
 #include "ipm_road_mapper/core/mapper/timing_series.h"
 
 namespace ipm_road_mapper {
@@ -101,6 +102,22 @@ FrameStatus Mapper::ProcessFrame(const FrameInput& input, std::string* reason) {
   return FrameStatus::kUsed;
 }
 
+std::optional<PoseEstimate> Mapper::NewestPose() const {
+  const std::vector<FrameRecord>& frames = store_.frames();
+  if (frames.empty()) return std::nullopt;
+  const FrameRecord& newest = frames.back();
+  PoseEstimate estimate;
+  estimate.stamp = newest.stamp;
+  const std::int64_t solved = store_.corrected_frame();
+  estimate.T_map_base = solved >= 0 && static_cast<std::size_t>(solved) < newest.index
+                            ? ExtrapolateNewestPose(frames, static_cast<std::size_t>(solved),
+                                                    store_.T_map_odom(), options_.backend)
+                            : store_.CorrectedPose(newest.index);
+  estimate.covariance = windows_.PoseCovarianceOf(newest.index);
+  estimate.T_map_odom = estimate.T_map_base * newest.T_map_base_odom.inverse();
+  return estimate;
+}
+
 void Mapper::PruneHistories() {
   // Every kPruneEveryFrames frames, so that the erasures are batched.
   constexpr std::size_t kPruneEveryFrames = 100;
@@ -170,7 +187,7 @@ VectorMap Mapper::ExportMap(const ExportOptions& export_options) const {
       max_poses > 0 && frames.size() > max_poses ? frames.size() - max_poses : 0;
   out.trajectory.reserve(frames.size() - first);
   for (std::size_t i = first; i < frames.size(); ++i) {
-    out.trajectory.push_back({frames[i].stamp, frames[i].T_map_base});
+    out.trajectory.push_back({frames[i].stamp, store_.CorrectedPose(i)});
   }
   out.metadata["method"] = options_.method;
   out.metadata["frames_received"] = counters_.frames_received;

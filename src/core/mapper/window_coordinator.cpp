@@ -72,7 +72,7 @@ WindowCoordinator::WindowCoordinator(const MapperOptions& options,
       extrinsic_prior_(T_base_cam_initial, options.backend.rotation_prior_sigma_rad,
                        options.backend.translation_prior_sigma_m,
                        options.backend.extrinsic_prior_memory_markings) {
-  covariance_ = extrinsic_prior_.H().inverse();
+  extrinsic_covariance_ = extrinsic_prior_.H().inverse();
   if (options_.backend.enabled) backend_ = std::make_unique<Backend>(options_.backend);
 }
 
@@ -88,7 +88,20 @@ BackendStats WindowCoordinator::stats() const {
   return backend_ ? backend_->stats() : BackendStats();
 }
 
+PoseCovariance WindowCoordinator::PoseCovarianceOf(std::size_t index) const {
+  const BackendOptions& o = options_.backend;
+  const Eigen::Isometry3d T_map_base = store_->CorrectedPose(index);
+  const PoseCovariance odometry =
+      OdometryPoseCovariance(T_map_base, o.pose_prior_sigma_trans_m, o.pose_prior_sigma_rot_rad);
+  if (pose_covariance_frame_ < 0 || static_cast<std::size_t>(pose_covariance_frame_) > index)
+    return odometry;
+  const std::size_t solved = static_cast<std::size_t>(pose_covariance_frame_);
+  return PropagatePoseCovariance(pose_covariance_, store_->frames()[solved].T_map_base, T_map_base,
+                                 solved == index ? PoseCovariance::Zero() : odometry);
+}
+
 void WindowCoordinator::Reset() {
+  pose_covariance_frame_ = -1;
   if (!backend_) return;
   backend_->Stop();  // results of the old map must not land in the new one
   backend_ = std::make_unique<Backend>(options_.backend);
@@ -185,6 +198,7 @@ void WindowCoordinator::FinalGlobalSolve(double time_budget_s) {
   snapshot.T_base_cam = T_base_cam_;
   snapshot.extrinsic_prior =
       ExtrinsicPrior(T_base_cam_initial_, o.rotation_prior_sigma_rad, o.translation_prior_sigma_m);
+  snapshot.newest_pose_covariance = false;  // the windows' covariance stands
   auto in_span = [start](const auto& measurement) { return measurement.frame_index >= start; };
   std::vector<const MarkingElement*> markings;
   for (const MarkingElement& m : store_->markings()) markings.push_back(&m);
@@ -316,13 +330,26 @@ void WindowCoordinator::ApplyResult(const WindowResult& result, bool include_ret
   if (result.extrinsic_rejected) {
     ++counters_->extrinsic_rejected;  // T_base_cam is the previous one; so is what is known
   } else {
-    covariance_ = result.T_base_cam_covariance;
+    extrinsic_covariance_ = result.T_base_cam_covariance;
     for (int i = 0; i < 6; ++i) observed_[i] = observed_[i] || result.extrinsic_observed[i];
   }
+  // The poses the pose step moved; the others are the snapshot's and may since have been
+  // corrected by a newer result.
+  std::int64_t newest_optimized = -1;
   for (const WindowFrame& f : result.frames) {
-    if (f.in_window && f.index < store_->frames().size()) {
+    if (f.in_window && f.optimized && f.index < store_->frames().size()) {
       store_->SetFramePose(f.index, f.T_map_base);
+      newest_optimized = std::max(newest_optimized, static_cast<std::int64_t>(f.index));
     }
+  }
+  // The newest corrected frame's correction, carried along the odometry to the frames after
+  // it in the outputs (MapStore::CorrectedPose; the estimator keeps the raw odometry as
+  // their start and prior: the correction is never a measurement).
+  if (newest_optimized >= 0) store_->SetCorrectionFrom(static_cast<std::size_t>(newest_optimized));
+  if (result.covariance_frame >= 0 &&
+      static_cast<std::size_t>(result.covariance_frame) < store_->frames().size()) {
+    pose_covariance_frame_ = result.covariance_frame;
+    pose_covariance_ = result.T_map_base_covariance;
   }
   if (options_.backend.optimize_markings) {
     std::unordered_map<std::uint64_t, MarkingElement*> by_id;

@@ -19,6 +19,7 @@
 
 #include "ipm_road_mapper/core/backend/backend_options.h"
 #include "ipm_road_mapper/core/backend/extrinsic_prior.h"
+#include "ipm_road_mapper/core/backend/pose_covariance.h"
 #include "ipm_road_mapper/core/geometry/pinhole_camera.h"
 #include "ipm_road_mapper/core/map/road_map.h"
 
@@ -33,6 +34,9 @@ struct WindowFrame {
   // measurements of the window's elements were made from it): its pose is data.
   bool in_window = true;
   double stamp = 0.0;  // s (the motion prior's time steps)
+  // In a result: its pose was free in the last pose step (data moved it); else it is the
+  // snapshot's (no measurement in the window touched it).
+  bool optimized = false;
 };
 
 // A marking observed in the window, with its in-window measurements.
@@ -69,6 +73,9 @@ struct WindowSnapshot {
   std::vector<WindowFrame> frames;  // sorted by index: the window and its context frames
   std::vector<WindowMarking> markings;
   std::vector<WindowLane> lanes;
+  // Whether the result carries the Ceres covariance of the newest optimized pose (off for
+  // the final global solve: its problem spans the drive).
+  bool newest_pose_covariance = true;
 };
 
 // What the optimizer hands back (immutable once published).
@@ -98,6 +105,10 @@ struct WindowResult {
   int iterations = 0;
   double initial_cost = 0.0, final_cost = 0.0;
   std::string summary;  // Ceres BriefReport of the last step
+  // The covariance of the newest optimized frame's pose after the last pose step
+  // (pose_covariance.h); covariance_frame is that frame's index, -1 when not computed.
+  std::int64_t covariance_frame = -1;
+  PoseCovariance T_map_base_covariance = PoseCovariance::Zero();
 };
 
 // Builds and solves the window's alternating problem. With a finite time_budget_s, each

@@ -22,10 +22,27 @@ class MapStore {
   // `road_plane_radius_m`: the radius of RoadSurfaceAt (backend.road_plane_radius_m).
   explicit MapStore(double road_plane_radius_m);
 
-  // Appends a used frame; its corrected pose starts at the odometry.
+  // Appends a used frame; its corrected pose starts at the odometry (the front end places
+  // its observations there, the pose prior pulls it there).
   const FrameRecord& AddFrame(double stamp, const Eigen::Isometry3d& T_map_base_odom);
   // Sets frame `index`'s corrected pose (a back-end result).
   void SetFramePose(std::size_t index, const Eigen::Isometry3d& T_map_base);
+  // Takes the correction of frame `index`, a frame a solve just moved (its corrected pose
+  // times its odometry's inverse), as the current one: the frames after it, which no solve
+  // has reached yet, come out corrected by it (CorrectedPose).
+  void SetCorrectionFrom(std::size_t index);
+  // The current correction, T_map_odom: the corrected map frame from the odometry's frame
+  // (identity until a solve moved a frame).
+  const Eigen::Isometry3d& T_map_odom() const { return T_map_odom_; }
+  // The frame T_map_odom() was taken from (-1: none yet).
+  std::int64_t corrected_frame() const { return corrected_frame_; }
+  // Frame `index`'s pose as it comes out (~corrected_odom, the exported trajectory): the
+  // solved pose, or for a frame after the last solve's newest one the correction carried
+  // along its odometry, T_map_odom() * T_map_base_odom. Not an input of the estimator: a
+  // frame's own T_map_base stays the odometry until a solve moves it (placing the front
+  // end's observations at the carried poses lets the map follow the correction and the
+  // correction random-walk away from the odometry: 0.04 -> 0.66 m on public_road).
+  Eigen::Isometry3d CorrectedPose(std::size_t index) const;
   // A fresh element id.
   std::uint64_t NewId() { return map_.next_id++; }
   // Moves the live markings flagged `retired` and last seen before `first_frame` into the
@@ -79,6 +96,8 @@ class MapStore {
   // Retired markings by the grid cell of their center (cells of kRetiredCellM).
   std::unordered_map<CellKey, std::vector<std::size_t>> retired_cells_;
   double max_retired_cov_trace_ = 0.0;
+  Eigen::Isometry3d T_map_odom_ = Eigen::Isometry3d::Identity();
+  std::int64_t corrected_frame_ = -1;  // the frame T_map_odom_ was taken from (-1: none)
   static constexpr double kRetiredCellM = 10.0;
 };
 

@@ -37,6 +37,17 @@ struct FrameInput {
   Eigen::Isometry3d T_map_base_odom = Eigen::Isometry3d::Identity();  // odometry at stamp
 };
 
+// A corrected vehicle pose with its covariance (pose_covariance.h: x y z, rotation about
+// the map axes), as ~corrected_odom publishes it.
+struct PoseEstimate {
+  double stamp = 0.0;  // s
+  Eigen::Isometry3d T_map_base = Eigen::Isometry3d::Identity();
+  PoseCovariance covariance = PoseCovariance::Zero();
+  // The correction at this frame, T_map_base * T_odom_base^-1 (REP-105 map -> odom): with
+  // the frame's odometry it gives T_map_base.
+  Eigen::Isometry3d T_map_odom = Eigen::Isometry3d::Identity();
+};
+
 // What happened to a frame.
 enum class FrameStatus { kUsed, kSkipped };
 
@@ -95,6 +106,17 @@ class Mapper {
     return windows_.T_base_cam_covariance();
   }
   const std::array<bool, 6>& extrinsic_observed() const { return windows_.extrinsic_observed(); }
+  // The newest used frame's corrected pose: until a solve reaches it, the solved trajectory
+  // continued over the frames since with the motion and odometry priors
+  // (pose_extrapolator.h; T_map_odom() * its odometry when that cannot run); nullopt before
+  // a frame.
+  std::optional<PoseEstimate> NewestPose() const;
+  // The correction of the odometry, T_map_odom (REP-105 map -> odom): identity until a
+  // solve corrected a frame; then T_map_base_opt * T_odom_base_opt^-1 of the newest frame
+  // the last solve moved; T_map_odom() * odometry is a later frame's carried pose
+  // (MapStore::CorrectedPose, the exported trajectory). The correction at the newest frame,
+  // what the nodelet broadcasts, is NewestPose()->T_map_odom.
+  const Eigen::Isometry3d& T_map_odom() const { return store_.T_map_odom(); }
 
  private:
   // Why an input cannot be used.

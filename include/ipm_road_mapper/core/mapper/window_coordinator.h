@@ -54,9 +54,14 @@ class WindowCoordinator {
   const Eigen::Isometry3d& T_base_cam() const { return T_base_cam_; }
   // Its covariance (roll, pitch, yaw about base_link in rad, x, y, z in m; the mounting
   // prior's until a result refines it) and the axes the data has observed.
-  const Eigen::Matrix<double, 6, 6>& T_base_cam_covariance() const { return covariance_; }
+  const Eigen::Matrix<double, 6, 6>& T_base_cam_covariance() const { return extrinsic_covariance_; }
   const std::array<bool, 6>& extrinsic_observed() const { return observed_; }
   BackendStats stats() const;
+  // The covariance of frame `index`'s corrected pose (pose_covariance.h): the last solve's
+  // covariance of its newest optimized frame carried along the odometry to it, plus the
+  // frame's own odometry noise (backend.pose_prior_sigma_*) when no solve has reached it;
+  // that noise alone before the first solve or without a back end.
+  PoseCovariance PoseCovarianceOf(std::size_t index) const;
   // The camera of the last used frame (the snapshots', and the export re-fit's).
   const CameraIntrinsics& camera() const { return camera_; }
 
@@ -83,8 +88,11 @@ class WindowCoordinator {
   CameraIntrinsics camera_;  // of the last used frame
   std::uint64_t next_sequence_ = 1;
   ExtrinsicPrior extrinsic_prior_;  // the mounting prior plus everything retired
-  Eigen::Matrix<double, 6, 6> covariance_;
+  Eigen::Matrix<double, 6, 6> extrinsic_covariance_;
   std::array<bool, 6> observed_{};
+  ExtrinsicPrior extrinsic_prior_;           // the mounting prior plus everything retired
+  std::int64_t pose_covariance_frame_ = -1;  // the frame of pose_covariance_ (-1: none yet)
+  PoseCovariance pose_covariance_ = PoseCovariance::Zero();
   std::unique_ptr<Backend> backend_;
 };
 
