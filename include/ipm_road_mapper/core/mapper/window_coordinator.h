@@ -90,7 +90,6 @@ class WindowCoordinator {
   ExtrinsicPrior extrinsic_prior_;  // the mounting prior plus everything retired
   Eigen::Matrix<double, 6, 6> extrinsic_covariance_;
   std::array<bool, 6> observed_{};
-  ExtrinsicPrior extrinsic_prior_;           // the mounting prior plus everything retired
   std::int64_t pose_covariance_frame_ = -1;  // the frame of pose_covariance_ (-1: none yet)
   PoseCovariance pose_covariance_ = PoseCovariance::Zero();
   std::unique_ptr<Backend> backend_;
