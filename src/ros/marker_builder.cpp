@@ -1,5 +1,6 @@
 #include "ipm_road_mapper/ros/marker_builder.h"
 
+#include <algorithm>
 #include <array>
 #include <cstdint>
 #include <exception>
@@ -7,6 +8,7 @@
 #include <vector>
 
 #include "ipm_road_mapper/core/geometry/catmull_rom_spline.h"
+#include "ipm_road_mapper/ros/element_fingerprint.h"
 #include "ipm_road_mapper/ros/msg_conversion.h"
 
 namespace ipm_road_mapper {
@@ -42,38 +44,17 @@ visualization_msgs::Marker NewMarker(const std::string& ns, int id, int type,
   return m;
 }
 
-// Points along the lane's curve; the control points themselves when the spline cannot be
-// built (fewer than 4 or non-finite points).
-std::vector<Eigen::Vector3d> LaneSamples(const MapLane& lane, double spacing_m) {
+// Points along the curve of control points [first, last) (segments first .. last - 4); the
+// control points themselves when no spline can be built (fewer than 4 or non-finite points).
+std::vector<Eigen::Vector3d> CurveSamples(const std::vector<Eigen::Vector3d>& control_points,
+                                          std::size_t first, std::size_t last, double spacing_m) {
+  const std::vector<Eigen::Vector3d> part(control_points.begin() + first,
+                                          control_points.begin() + last);
   try {
-    return CatmullRomSpline(lane.control_points_map).SampleByArcLength(spacing_m);
+    return CatmullRomSpline(part).SampleByArcLength(spacing_m);
   } catch (const std::exception&) {
-    return lane.control_points_map;
+    return part;
   }
-}
-
-void HashCombine(std::size_t* seed, std::size_t value) {
-  *seed ^= value + 0x9e3779b97f4a7c15ull + (*seed << 6) + (*seed >> 2);
-}
-
-void HashPoint(std::size_t* seed, const Eigen::Vector3d& p) {
-  for (int i = 0; i < 3; ++i) HashCombine(seed, std::hash<double>()(p[i]));
-}
-
-// What a lane's markers depend on: class and control points.
-std::size_t Fingerprint(const MapLane& lane) {
-  std::size_t seed = std::hash<int>()(lane.class_id);
-  HashCombine(&seed, std::hash<std::string>()(lane.class_name));
-  for (const Eigen::Vector3d& c : lane.control_points_map) HashPoint(&seed, c);
-  return seed;
-}
-
-// What a marking's markers depend on: class and corners.
-std::size_t Fingerprint(const MapMarking& marking) {
-  std::size_t seed = std::hash<int>()(marking.class_id);
-  HashCombine(&seed, std::hash<std::string>()(marking.class_name));
-  for (const Eigen::Vector3d& c : marking.corners_map) HashPoint(&seed, c);
-  return seed;
 }
 
 }  // namespace
@@ -98,8 +79,26 @@ std_msgs::ColorRGBA ClassColor(int class_id, const std::string& class_name) {
   return Rgba(c[0], c[1], c[2]);
 }
 
-MarkerBuilder::MarkerBuilder(double lane_sample_spacing_m)
-    : lane_sample_spacing_m_(lane_sample_spacing_m > 0.0 ? lane_sample_spacing_m : 0.5) {}
+int LaneChunkMarkerId(std::uint64_t lane_id, std::size_t chunk) {
+  return static_cast<int>(((lane_id & 0x1fffffu) << 10) | (chunk & 0x3ffu));
+}
+
+std::vector<LaneChunk> LaneChunks(std::size_t control_points, std::size_t chunk_segments) {
+  chunk_segments = std::max<std::size_t>(chunk_segments, 1);
+  if (control_points < 4) return {{0, 0, control_points, 0, control_points}};
+  const std::size_t segments = control_points - 3;
+  std::vector<LaneChunk> chunks;
+  for (std::size_t first = 0; first < segments; first += chunk_segments) {
+    const std::size_t end = std::min(first + chunk_segments, segments);
+    const bool last = end == segments;
+    chunks.push_back({chunks.size(), first, end + 3, first, last ? control_points : end});
+  }
+  return chunks;
+}
+
+MarkerBuilder::MarkerBuilder(double lane_sample_spacing_m, std::size_t lane_chunk_segments)
+    : lane_sample_spacing_m_(lane_sample_spacing_m > 0.0 ? lane_sample_spacing_m : 0.5),
+      lane_chunk_segments_(std::max<std::size_t>(lane_chunk_segments, 1)) {}
 
 visualization_msgs::MarkerArray MarkerBuilder::Build(const VectorMap& map,
                                                      const std::string& frame_id,
@@ -130,26 +129,32 @@ visualization_msgs::MarkerArray MarkerBuilder::Build(const VectorMap& map,
     return true;
   };
   for (const MapLane& lane : map.lanes) {
-    const int id = MarkerId(lane.id);
-    fingerprint = Fingerprint(lane);
-    if (unchanged(kLaneNs, kControlPointNs, id)) continue;
+    const std::vector<Eigen::Vector3d>& cps = lane.control_points_map;
     const std_msgs::ColorRGBA color = ClassColor(lane.class_id, lane.class_name);
-    Marker line = NewMarker(kLaneNs, id, Marker::LINE_STRIP, frame_id, stamp);
-    line.scale.x = 0.15;  // line width, m (a painted lane line)
-    line.color = color;
-    for (const Eigen::Vector3d& p : LaneSamples(lane, lane_sample_spacing_m_)) {
-      line.points.push_back(ToPointMsg(p));
+    for (const LaneChunk& chunk : LaneChunks(cps.size(), lane_chunk_segments_)) {
+      const int id = LaneChunkMarkerId(lane.id, chunk.index);
+      fingerprint = GeometryFingerprint(lane, chunk.curve_first, chunk.curve_last);
+      if (unchanged(kLaneNs, kControlPointNs, id)) continue;
+      Marker line = NewMarker(kLaneNs, id, Marker::LINE_STRIP, frame_id, stamp);
+      line.scale.x = 0.15;  // line width, m (a painted lane line)
+      line.color = color;
+      for (const Eigen::Vector3d& p :
+           CurveSamples(cps, chunk.curve_first, chunk.curve_last, lane_sample_spacing_m_)) {
+        line.points.push_back(ToPointMsg(p));
+      }
+      if (line.points.size() >= 2) add(line);
+      Marker points = NewMarker(kControlPointNs, id, Marker::SPHERE_LIST, frame_id, stamp);
+      points.scale.x = points.scale.y = points.scale.z = 0.3;
+      points.color = Rgba(color.r * 0.6f, color.g * 0.6f, color.b * 0.6f + 0.4f);
+      for (std::size_t i = chunk.points_first; i < chunk.points_last; ++i) {
+        points.points.push_back(ToPointMsg(cps[i]));
+      }
+      if (!points.points.empty()) add(points);
     }
-    if (line.points.size() >= 2) add(line);
-    Marker points = NewMarker(kControlPointNs, id, Marker::SPHERE_LIST, frame_id, stamp);
-    points.scale.x = points.scale.y = points.scale.z = 0.3;
-    points.color = Rgba(color.r * 0.6f, color.g * 0.6f, color.b * 0.6f + 0.4f);
-    for (const Eigen::Vector3d& c : lane.control_points_map) points.points.push_back(ToPointMsg(c));
-    if (!points.points.empty()) add(points);
   }
   for (const MapMarking& marking : map.markings) {
     const int id = MarkerId(marking.id);
-    fingerprint = Fingerprint(marking);
+    fingerprint = GeometryFingerprint(marking);
     if (unchanged(kMarkingNs, kLabelNs, id)) continue;
     const std_msgs::ColorRGBA color = ClassColor(marking.class_id, marking.class_name);
     Marker outline = NewMarker(kMarkingNs, id, Marker::LINE_STRIP, frame_id, stamp);

@@ -1,0 +1,56 @@
+// Builds ~vector_map_delta messages (msg/VectorMapDelta.msg): the markings of a map that are
+// new or changed since the previous delta, the changed end of each new or changed lane
+// (LaneSplinePatch), and the ids of the elements that left the map. It remembers a
+// fingerprint per marking and per chunk of each lane's control points, so a message
+// carries what changed, not the whole map: retired markings, which no solve moves any
+// more, are sent once; a lane that grows sends its last chunk or two.
+#pragma once
+
+#include <ros/time.h>
+
+#include <cstddef>
+#include <cstdint>
+#include <string>
+#include <unordered_map>
+#include <vector>
+
+#include "ipm_road_mapper/VectorMapDelta.h"
+#include "ipm_road_mapper/core/map/vector_map.h"
+
+namespace ipm_road_mapper {
+
+class VectorMapDeltaBuilder {
+ public:
+  // Lane control points are compared in chunks of `lane_chunk_points` (> 0).
+  explicit VectorMapDeltaBuilder(std::size_t lane_chunk_points = 16);
+
+  // The delta from the previous call's map to `map`, in `frame_id` at `stamp` (the first
+  // call: every element).
+  ipm_road_mapper::VectorMapDelta Build(const VectorMap& map, const std::string& frame_id,
+                                        const ros::Time& stamp);
+
+  // A delta with `reset` set and nothing else (after ~reset); forgets every element.
+  ipm_road_mapper::VectorMapDelta Clear(const std::string& frame_id, const ros::Time& stamp);
+
+ private:
+  // What was sent of one lane.
+  struct LaneSent {
+    std::size_t fields = 0;           // MessageFingerprint without the control points
+    std::vector<std::size_t> chunks;  // fingerprint per chunk of control points
+    std::size_t points = 0;
+  };
+  LaneSent Describe(const MapLane& lane) const;
+  ipm_road_mapper::VectorMapDelta NewDelta(const std::string& frame_id, const ros::Time& stamp);
+
+  std::size_t lane_chunk_points_;
+  std::uint32_t sequence_ = 0;
+  std::unordered_map<std::uint64_t, std::size_t> markings_;  // id -> MessageFingerprint
+  std::unordered_map<std::uint64_t, LaneSent> lanes_;
+};
+
+// Applies `delta` to `map` (a client's copy, started from a ~vector_map): what a subscriber
+// of both topics does. Lane patches whose first_index is past the lane's points are applied
+// at its end.
+void ApplyVectorMapDelta(const ipm_road_mapper::VectorMapDelta& delta, VectorMap* map);
+
+}  // namespace ipm_road_mapper
