@@ -41,28 +41,31 @@ PublishCounts MapPublisher::Publish(const VectorMap& map, const std::string& map
     counts.markers = markers.markers.size();
     counts.serialized_bytes += ros::serialization::serializationLength(markers);
   }
-  if (!map_changed) return counts;
-  const ipm_road_mapper::VectorMapDelta delta = deltas_.Build(map, map_frame, stamp);
-  delta_pub_.publish(delta);
-  counts.delta_elements = delta.markings.size() + delta.lanes.size() +
-                          delta.removed_marking_ids.size() + delta.removed_lane_ids.size();
-  counts.serialized_bytes += ros::serialization::serializationLength(delta);
-  if (last_full_map_.isZero() || now - last_full_map_ >= vector_map_full_period_) {
+  if (map_changed) {
+    full_map_stale_ = true;
+    const ipm_road_mapper::VectorMapDelta delta = deltas_.Build(map, map_frame, stamp);
+    delta_pub_.publish(delta);
+    counts.delta_elements = delta.markings.size() + delta.lanes.size() +
+                            delta.removed_marking_ids.size() + delta.removed_lane_ids.size();
+    counts.serialized_bytes += ros::serialization::serializationLength(delta);
+    const nav_msgs::Path path = ToPathMsg(map.trajectory, map_frame, path_max_poses_, stamp);
+    path_pub_.publish(path);
+    counts.path_poses = path.poses.size();
+    counts.serialized_bytes += ros::serialization::serializationLength(path);
+    const bool moved = !last_T_base_cam_ || !last_T_base_cam_->isApprox(map.T_base_cam, 1e-12);
+    if (moved) {
+      static_tf_.sendTransform(
+          IsometryToTransformStamped(map.T_base_cam, stamp, base_frame, refined_camera_frame));
+      last_T_base_cam_ = map.T_base_cam;
+    }
+  }
+  if (FullMapDueLocked(now)) {
     last_full_map_ = now;
+    full_map_stale_ = false;
     const ipm_road_mapper::VectorMapMsg full_map = ToVectorMapMsg(map, map_frame, stamp);
     vector_map_pub_.publish(full_map);
     counts.full_elements = full_map.markings.size() + full_map.lanes.size();
     counts.serialized_bytes += ros::serialization::serializationLength(full_map);
-  }
-  const nav_msgs::Path path = ToPathMsg(map.trajectory, map_frame, path_max_poses_, stamp);
-  path_pub_.publish(path);
-  counts.path_poses = path.poses.size();
-  counts.serialized_bytes += ros::serialization::serializationLength(path);
-  const bool changed = !last_T_base_cam_ || !last_T_base_cam_->isApprox(map.T_base_cam, 1e-12);
-  if (changed) {
-    static_tf_.sendTransform(
-        IsometryToTransformStamped(map.T_base_cam, stamp, base_frame, refined_camera_frame));
-    last_T_base_cam_ = map.T_base_cam;
   }
   return counts;
 }
@@ -73,11 +76,22 @@ bool MapPublisher::full_markers_due() const {
          ros::WallTime::now() - last_full_markers_ >= marker_full_period_;
 }
 
+bool MapPublisher::full_map_due() const {
+  std::lock_guard<std::mutex> lock(mutex_);
+  return FullMapDueLocked(ros::WallTime::now());
+}
+
+bool MapPublisher::FullMapDueLocked(const ros::WallTime& now) const {
+  return full_map_stale_ &&
+         (last_full_map_.isZero() || now - last_full_map_ >= vector_map_full_period_);
+}
+
 void MapPublisher::Clear(const std::string& map_frame, const ros::Time& stamp) {
   std::lock_guard<std::mutex> lock(mutex_);
   VectorMap empty;
   vector_map_pub_.publish(ToVectorMapMsg(empty, map_frame, stamp));
   last_full_map_ = ros::WallTime::now();
+  full_map_stale_ = false;
   delta_pub_.publish(deltas_.Clear(map_frame, stamp));
   markers_pub_.publish(markers_.Clear());
   path_pub_.publish(ToPathMsg({}, map_frame, path_max_poses_, stamp));

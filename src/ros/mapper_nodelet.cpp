@@ -232,7 +232,7 @@ void MapperNodelet::OnPublishTimer() {
   const std::shared_ptr<const MapSnapshot> snapshot = worker_->Latest();
   if (!snapshot->map) return;
   const bool changed = snapshot->map_version != published_version_;
-  if (!changed && !map_publisher_->full_markers_due()) return;
+  if (!changed && !map_publisher_->full_markers_due() && !map_publisher_->full_map_due()) return;
   published_version_ = snapshot->map_version;
   const double cpu_start_ms = ThreadCpuMs();
   const PublishCounts counts = map_publisher_->Publish(

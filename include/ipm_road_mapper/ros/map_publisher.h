@@ -43,8 +43,9 @@ class MapPublisher {
                double vector_map_full_period_s);
 
   // Publishes one map snapshot in `map_frame` at `stamp`, and the refined extrinsic as
-  // base_frame -> refined_camera_frame. `map_changed` false: only a due full marker set
-  // (the map was published before). Thread-safe (one publication at a time).
+  // base_frame -> refined_camera_frame. `map_changed` false: only a due full marker set or
+  // full ~vector_map (the map was published before). Thread-safe (one publication at a
+  // time).
   PublishCounts Publish(const VectorMap& map, const std::string& map_frame,
                         const std::string& base_frame, const std::string& refined_camera_frame,
                         const ros::Time& stamp, bool map_changed = true);
@@ -53,16 +54,23 @@ class MapPublisher {
   // the period elapsed).
   bool full_markers_due() const;
 
+  // True when the next Publish sends the full ~vector_map: the map changed since the last
+  // one and `vector_map_full_period_s` elapsed (so the final map always goes out in full).
+  bool full_map_due() const;
+
   // After ~reset: an empty map, an empty path, every marker deleted.
   void Clear(const std::string& map_frame, const ros::Time& stamp);
 
  private:
+  bool FullMapDueLocked(const ros::WallTime& now) const;
+
   mutable std::mutex mutex_;
   int path_max_poses_;
   ros::WallDuration marker_full_period_;
   ros::WallDuration vector_map_full_period_;
   ros::WallTime last_full_markers_, last_full_map_;
   std::atomic<bool> new_marker_subscriber_{true};
+  bool full_map_stale_ = false;  // the map changed since the last full ~vector_map
   ros::Publisher vector_map_pub_, delta_pub_, markers_pub_, path_pub_;
   tf2_ros::StaticTransformBroadcaster static_tf_;
   MarkerBuilder markers_;
