@@ -127,6 +127,13 @@ void FillOptimizerStatus(const MapperStatusSnapshot& now, const MapperStatusSnap
           t.empty() ? 0.0 : 1e3 * *std::max_element(t.begin(), t.end()));
   if (!now.backend_enabled) {
     s->summary(DiagnosticStatus::OK, "disabled (front end only)");
+  } else if (b.dropped_queue_full > previous.backend.dropped_queue_full) {
+    // Windows come faster than they are solved (e.g. a bag played faster than real time):
+    // the dropped windows' lanes and poses go unrefined, lanes fragment.
+    s->summary(DiagnosticStatus::WARN,
+               "the optimizer falls behind: " +
+                   std::to_string(b.dropped_queue_full - previous.backend.dropped_queue_full) +
+                   " window(s) dropped since the last update (input faster than the solves)");
   } else if (b.unusable > previous.backend.unusable) {
     s->summary(DiagnosticStatus::WARN, "a window solve was unusable");
   } else {
