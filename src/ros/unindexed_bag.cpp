@@ -9,10 +9,13 @@
 #include <cstdint>
 #include <cstring>
 #include <exception>
+#include <filesystem>
 #include <fstream>
 #include <map>
 #include <optional>
 #include <vector>
+
+#include "ipm_road_mapper/ros/bag_input.h"
 
 namespace ipm_road_mapper {
 namespace {
@@ -248,6 +251,34 @@ std::string SalvageUnindexedBag(const std::string& path, const std::string& copy
     return std::string("cannot write the indexed copy ") + copy_path + ": " + e.what();
   }
   if (salvage->messages == 0) return "no message could be read in record order";
+  return "";
+}
+
+OpenedBag::~OpenedBag() {
+  bag_.close();
+  std::error_code ignored;
+  if (!copy_path_.empty()) std::filesystem::remove(copy_path_, ignored);
+}
+
+std::string OpenedBag::Open(const std::string& path, const std::string& copy_folder) {
+  const std::string error = OpenBagForReading(path, &bag_);
+  if (error.empty()) return "";
+  const BagIndexCheck check = CheckBagIndex(path);
+  if (!check.index_missing) return error;
+  std::error_code ignored;
+  std::filesystem::create_directories(copy_folder, ignored);
+  copy_path_ = (std::filesystem::path(copy_folder) /
+                ("." + std::filesystem::path(path).stem().string() + ".indexed.bag"))
+                   .string();
+  BagSalvage salvage;
+  const std::string why = SalvageUnindexedBag(path, copy_path_, &salvage);
+  if (!why.empty()) return error + " (reading it in record order failed too: " + why + ")";
+  bag_.close();  // the failed open keeps the file
+  if (const std::string reopen = OpenBagForReading(copy_path_, &bag_); !reopen.empty()) {
+    return error + " (its indexed copy: " + reopen + ")";
+  }
+  salvage_ = salvage;
+  index_problem_ = check.problem;
   return "";
 }
 

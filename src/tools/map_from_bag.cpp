@@ -39,7 +39,6 @@
 #include <filesystem>
 #include <fstream>
 #include <iostream>
-#include <memory>
 #include <optional>
 #include <sstream>
 #include <stdexcept>
@@ -153,21 +152,6 @@ struct RunStats {
   double bag_begin_s = 0.0;           // the bag's first record time; lost spans are relative to it
   std::string index_problem;          // why the bag had to be read past its index ("" = not)
   std::optional<BagSalvage> salvage;  // what reading it in record order gave
-};
-
-// Removes a file when it goes out of scope (the indexed copy of an unindexed bag).
-class RemovedAtExit {
- public:
-  explicit RemovedAtExit(std::string path) : path_(std::move(path)) {}
-  ~RemovedAtExit() {
-    std::error_code ignored;
-    if (!path_.empty()) std::filesystem::remove(path_, ignored);
-  }
-  RemovedAtExit(const RemovedAtExit&) = delete;
-  RemovedAtExit& operator=(const RemovedAtExit&) = delete;
-
- private:
-  std::string path_;
 };
 
 // The summary line about the bag's index: "ok", or how the bag was read past a missing one.
@@ -299,29 +283,16 @@ int Run(int argc, char** argv) {
   }
   if (!fs::is_regular_file(args.bag)) throw InputError(args.bag + ": no such bag file");
   RunStats stats;
-  std::unique_ptr<RemovedAtExit> indexed_copy;  // declared before the bag: removed after it
-  rosbag::Bag bag;
-  if (const std::string error = OpenBagForReading(args.bag, &bag); !error.empty()) {
-    const BagIndexCheck check = CheckBagIndex(args.bag);
-    if (!check.index_missing) throw InputError(error);
-    // No index: read its records in order into an indexed copy, and map that.
-    std::error_code dir_error;
-    fs::create_directories(args.out, dir_error);
-    const std::string copy =
-        (fs::path(args.out) / ("." + fs::path(args.bag).stem().string() + ".indexed.bag")).string();
-    indexed_copy = std::make_unique<RemovedAtExit>(copy);
-    BagSalvage salvage;
-    const std::string why = SalvageUnindexedBag(args.bag, copy, &salvage);
-    if (!why.empty()) {
-      throw InputError(error + " (reading it in record order failed too: " + why + ")");
-    }
-    bag.close();  // the failed open keeps the file
-    if (const std::string reopen = OpenBagForReading(copy, &bag); !reopen.empty()) {
-      throw InputError(error + " (its indexed copy: " + reopen + ")");
-    }
-    stats.index_problem = check.problem;
+  OpenedBag opened;  // the bag, or the indexed copy of one without its index
+  if (const std::string error = opened.Open(args.bag, args.out); !error.empty()) {
+    throw InputError(error);
+  }
+  rosbag::Bag& bag = opened.bag();
+  if (opened.salvage()) {
+    const BagSalvage& salvage = *opened.salvage();
+    stats.index_problem = opened.index_problem();
     stats.salvage = salvage;
-    std::cerr << "map_from_bag: " << args.bag << ": " << check.problem
+    std::cerr << "map_from_bag: " << args.bag << ": " << opened.index_problem()
               << ": read past the missing index in record order (" << salvage.messages
               << " messages in " << salvage.chunks << " chunks; " << salvage.end
               << "); mapping what it holds\n";

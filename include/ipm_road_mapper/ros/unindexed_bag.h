@@ -7,7 +7,10 @@
 // file; a chunk that does not decompress is skipped and counted.
 #pragma once
 
+#include <rosbag/bag.h>
+
 #include <cstddef>
+#include <optional>
 #include <string>
 
 namespace ipm_road_mapper {
@@ -27,5 +30,33 @@ struct BagSalvage {
 // (at least one message copied), otherwise one phrase why not.
 std::string SalvageUnindexedBag(const std::string& path, const std::string& copy_path,
                                 BagSalvage* salvage);
+
+// A bag opened for reading: the file itself when rosbag can open it, else (its index
+// missing) the indexed copy SalvageUnindexedBag makes in a folder, removed with this object.
+class OpenedBag {
+ public:
+  OpenedBag() = default;
+  OpenedBag(const OpenedBag&) = delete;
+  OpenedBag& operator=(const OpenedBag&) = delete;
+  // Closes the bag and removes the copy, if one was made.
+  ~OpenedBag();
+
+  // Opens `path`; without its index, salvages it into `<copy_folder>/.<stem>.indexed.bag`
+  // (the folder is created) and opens that. Empty on success, else the one-line error of
+  // OpenBagForReading (with why salvaging failed too, when it was tried).
+  std::string Open(const std::string& path, const std::string& copy_folder);
+
+  rosbag::Bag& bag() { return bag_; }
+  // Set when the copy is what was opened.
+  const std::optional<BagSalvage>& salvage() const { return salvage_; }
+  // Why the bag had to be salvaged (CheckBagIndex's phrase); "" when not.
+  const std::string& index_problem() const { return index_problem_; }
+
+ private:
+  rosbag::Bag bag_;
+  std::string copy_path_;
+  std::optional<BagSalvage> salvage_;
+  std::string index_problem_;
+};
 
 }  // namespace ipm_road_mapper
