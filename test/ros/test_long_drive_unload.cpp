@@ -115,14 +115,15 @@ TEST(LongDriveUnload, FinishesAndSavesWithinTheBudget) {
   const double saved_s = Seconds(Clock::now() - unload_start);
   worker.Stop();
   const double unload_s = Seconds(Clock::now() - unload_start);
-  const double km = map->trajectory.empty()
-                        ? 0.0
-                        : 1e-3 * (map->trajectory.back().T_map_base.translation() -
-                                  map->trajectory.front().T_map_base.translation())
-                                     .norm();
+  double km = 0.0;  // path length
+  for (std::size_t i = 1; i < map->trajectory.size(); ++i) {
+    km += 1e-3 * (map->trajectory[i].T_map_base.translation() -
+                  map->trajectory[i - 1].T_map_base.translation())
+                     .norm();
+  }
   std::printf(
       "long drive: %lu frames pushed in %.1f s (%lu poses, %zu markings, %zu lanes, %.2f km "
-      "start to end); unload: Finish %.2f s (%s), saved at %.2f s, mapping thread joined at "
+      "driven); unload: Finish %.2f s (%s), saved at %.2f s, mapping thread joined at "
       "%.2f s; budget %.1f s\n",
       static_cast<unsigned long>(pushed), feed_s,
       static_cast<unsigned long>(map->trajectory.size()), map->markings.size(), map->lanes.size(),
