@@ -51,6 +51,13 @@ std::size_t MessageFingerprint(const MapMarking& marking) {
 
 std::size_t MessageFingerprint(const MapLane& lane) {
   std::size_t seed = GeometryFingerprint(lane, 0, lane.control_points_map.size());
+  HashCombine(&seed, FieldsFingerprint(lane));
+  return seed;
+}
+
+std::size_t FieldsFingerprint(const MapLane& lane) {
+  std::size_t seed = 0;
+  HashClass(&seed, lane.class_id, lane.class_name);
   HashCombine(&seed, std::hash<std::string>()(lane.style));
   HashLife(&seed, lane.observations, lane.first_seen, lane.last_seen);
   return seed;

@@ -14,10 +14,14 @@
 namespace ipm_road_mapper {
 namespace {
 
-constexpr const char* kLaneNs = "lanes";
-constexpr const char* kControlPointNs = "lane_control_points";
-constexpr const char* kMarkingNs = "markings";
-constexpr const char* kLabelNs = "marking_labels";
+// The marker namespaces, by index (a marker's key is its namespace index and id).
+constexpr std::array<const char*, 4> kNamespaces = {"lanes", "lane_control_points", "markings",
+                                                    "marking_labels"};
+constexpr std::size_t kLaneNs = 0, kControlPointNs = 1, kMarkingNs = 2, kLabelNs = 3;
+
+std::uint64_t Key(std::size_t ns, int id) {
+  return (static_cast<std::uint64_t>(ns) << 32) | static_cast<std::uint32_t>(id);
+}
 
 std_msgs::ColorRGBA Rgba(float r, float g, float b, float a = 1.0f) {
   std_msgs::ColorRGBA c;
@@ -105,26 +109,26 @@ visualization_msgs::MarkerArray MarkerBuilder::Build(const VectorMap& map,
                                                      const ros::Time& stamp, Mode mode) {
   using visualization_msgs::Marker;
   visualization_msgs::MarkerArray out;
-  std::map<MarkerKey, std::size_t> now;
+  ++generation_;
   std::size_t fingerprint = 0;
-  auto add = [&](Marker marker) {
-    now[{marker.ns, marker.id}] = fingerprint;
+  auto add = [&](std::size_t ns, Marker marker) {
+    published_[Key(ns, marker.id)] = {fingerprint, generation_};
     out.markers.push_back(std::move(marker));
   };
   // kChanges: an element drawn before with the same fingerprint keeps its markers as sent.
-  auto unchanged = [&](const char* ns_a, const char* ns_b, int id) {
+  auto unchanged = [&](std::size_t ns_a, std::size_t ns_b, int id) {
     if (mode != Mode::kChanges) return false;
     bool any = false, same = true;
-    for (const char* ns : {ns_a, ns_b}) {
-      const auto it = published_.find({ns, id});
+    for (const std::size_t ns : {ns_a, ns_b}) {
+      const auto it = published_.find(Key(ns, id));
       if (it == published_.end()) continue;
       any = true;
-      same = same && it->second == fingerprint;
+      same = same && it->second.fingerprint == fingerprint;
     }
     if (!any || !same) return false;
-    for (const char* ns : {ns_a, ns_b}) {
-      const auto it = published_.find({ns, id});
-      if (it != published_.end()) now.insert(*it);
+    for (const std::size_t ns : {ns_a, ns_b}) {
+      const auto it = published_.find(Key(ns, id));
+      if (it != published_.end()) it->second.generation = generation_;
     }
     return true;
   };
@@ -135,21 +139,22 @@ visualization_msgs::MarkerArray MarkerBuilder::Build(const VectorMap& map,
       const int id = LaneChunkMarkerId(lane.id, chunk.index);
       fingerprint = GeometryFingerprint(lane, chunk.curve_first, chunk.curve_last);
       if (unchanged(kLaneNs, kControlPointNs, id)) continue;
-      Marker line = NewMarker(kLaneNs, id, Marker::LINE_STRIP, frame_id, stamp);
+      Marker line = NewMarker(kNamespaces[kLaneNs], id, Marker::LINE_STRIP, frame_id, stamp);
       line.scale.x = 0.15;  // line width, m (a painted lane line)
       line.color = color;
       for (const Eigen::Vector3d& p :
            CurveSamples(cps, chunk.curve_first, chunk.curve_last, lane_sample_spacing_m_)) {
         line.points.push_back(ToPointMsg(p));
       }
-      if (line.points.size() >= 2) add(line);
-      Marker points = NewMarker(kControlPointNs, id, Marker::SPHERE_LIST, frame_id, stamp);
+      if (line.points.size() >= 2) add(kLaneNs, std::move(line));
+      Marker points =
+          NewMarker(kNamespaces[kControlPointNs], id, Marker::SPHERE_LIST, frame_id, stamp);
       points.scale.x = points.scale.y = points.scale.z = 0.3;
       points.color = Rgba(color.r * 0.6f, color.g * 0.6f, color.b * 0.6f + 0.4f);
       for (std::size_t i = chunk.points_first; i < chunk.points_last; ++i) {
         points.points.push_back(ToPointMsg(cps[i]));
       }
-      if (!points.points.empty()) add(points);
+      if (!points.points.empty()) add(kControlPointNs, std::move(points));
     }
   }
   for (const MapMarking& marking : map.markings) {
@@ -157,26 +162,31 @@ visualization_msgs::MarkerArray MarkerBuilder::Build(const VectorMap& map,
     fingerprint = GeometryFingerprint(marking);
     if (unchanged(kMarkingNs, kLabelNs, id)) continue;
     const std_msgs::ColorRGBA color = ClassColor(marking.class_id, marking.class_name);
-    Marker outline = NewMarker(kMarkingNs, id, Marker::LINE_STRIP, frame_id, stamp);
+    Marker outline = NewMarker(kNamespaces[kMarkingNs], id, Marker::LINE_STRIP, frame_id, stamp);
     outline.scale.x = 0.08;
     outline.color = color;
     for (int i = 0; i <= 4; ++i) outline.points.push_back(ToPointMsg(marking.corners_map[i % 4]));
-    add(outline);
-    Marker label = NewMarker(kLabelNs, id, Marker::TEXT_VIEW_FACING, frame_id, stamp);
+    add(kMarkingNs, std::move(outline));
+    Marker label = NewMarker(kNamespaces[kLabelNs], id, Marker::TEXT_VIEW_FACING, frame_id, stamp);
     label.pose.position = ToPointMsg(marking.Center() + Eigen::Vector3d(0.0, 0.0, 0.5));
     label.scale.z = 0.6;  // text height, m
     label.color = color;
     label.text = marking.class_name.empty() ? "class " + std::to_string(marking.class_id)
                                             : marking.class_name;
-    add(label);
+    add(kLabelNs, std::move(label));
   }
-  for (const auto& [key, unused] : published_) {
-    if (now.count(key)) continue;
-    Marker gone = NewMarker(key.first, key.second, Marker::LINE_STRIP, frame_id, stamp);
+  // What this map no longer draws: deleted on screen and forgotten.
+  for (auto it = published_.begin(); it != published_.end();) {
+    if (it->second.generation == generation_) {
+      ++it;
+      continue;
+    }
+    Marker gone = NewMarker(kNamespaces[it->first >> 32], static_cast<int>(it->first & 0xffffffffu),
+                            Marker::LINE_STRIP, frame_id, stamp);
     gone.action = Marker::DELETE;
     out.markers.push_back(gone);
+    it = published_.erase(it);
   }
-  published_ = std::move(now);
   return out;
 }
 

@@ -12,13 +12,19 @@
 namespace ipm_road_mapper {
 namespace {
 
-// The ids of `previous` that are not in `now` (the elements that left the map).
-template <typename Value>
-std::vector<std::uint64_t> Vanished(const std::unordered_map<std::uint64_t, Value>& previous,
-                                    const std::unordered_map<std::uint64_t, Value>& now) {
+// Erases the entries `generation` did not see and returns their ids, sorted (the elements
+// that left the map).
+template <typename Sent>
+std::vector<std::uint64_t> EraseUnseen(std::unordered_map<std::uint64_t, Sent>* sent,
+                                       std::uint64_t generation) {
   std::vector<std::uint64_t> gone;
-  for (const auto& [id, unused] : previous) {
-    if (!now.count(id)) gone.push_back(id);
+  for (auto it = sent->begin(); it != sent->end();) {
+    if (it->second.generation == generation) {
+      ++it;
+      continue;
+    }
+    gone.push_back(it->first);
+    it = sent->erase(it);
   }
   std::sort(gone.begin(), gone.end());
   return gone;
@@ -45,16 +51,13 @@ ipm_road_mapper::LaneSplinePatch Patch(const MapLane& lane, std::size_t first) {
 VectorMapDeltaBuilder::VectorMapDeltaBuilder(std::size_t lane_chunk_points)
     : lane_chunk_points_(std::max<std::size_t>(lane_chunk_points, 1)) {}
 
-VectorMapDeltaBuilder::LaneSent VectorMapDeltaBuilder::Describe(const MapLane& lane) const {
-  LaneSent sent;
-  MapLane fields = lane;
-  fields.control_points_map.clear();
-  sent.fields = MessageFingerprint(fields);
-  sent.points = lane.control_points_map.size();
-  for (std::size_t first = 0; first < sent.points; first += lane_chunk_points_) {
-    sent.chunks.push_back(GeometryFingerprint(lane, first, first + lane_chunk_points_));
+void VectorMapDeltaBuilder::Describe(const MapLane& lane, LaneSent* sent) const {
+  sent->fields = FieldsFingerprint(lane);
+  sent->points = lane.control_points_map.size();
+  sent->chunks.clear();
+  for (std::size_t first = 0; first < sent->points; first += lane_chunk_points_) {
+    sent->chunks.push_back(GeometryFingerprint(lane, first, first + lane_chunk_points_));
   }
-  return sent;
 }
 
 ipm_road_mapper::VectorMapDelta VectorMapDeltaBuilder::NewDelta(const std::string& frame_id,
@@ -71,22 +74,21 @@ ipm_road_mapper::VectorMapDelta VectorMapDeltaBuilder::Build(const VectorMap& ma
                                                              const std::string& frame_id,
                                                              const ros::Time& stamp) {
   ipm_road_mapper::VectorMapDelta delta = NewDelta(frame_id, stamp);
-  std::unordered_map<std::uint64_t, std::size_t> markings;
-  markings.reserve(map.markings.size());
+  ++generation_;
   for (const MapMarking& marking : map.markings) {
     const std::size_t fingerprint = MessageFingerprint(marking);
-    markings[marking.id] = fingerprint;
-    const auto it = markings_.find(marking.id);
-    if (it == markings_.end() || it->second != fingerprint) {
+    const auto [it, added] = markings_.try_emplace(marking.id);
+    if (added || it->second.fingerprint != fingerprint) {
       delta.markings.push_back(ToMarkingMsg(marking));
     }
+    it->second = {fingerprint, generation_};
   }
-  std::unordered_map<std::uint64_t, LaneSent> lanes;
-  lanes.reserve(map.lanes.size());
+  LaneSent now;
   for (const MapLane& lane : map.lanes) {
-    LaneSent now = Describe(lane);
-    const auto it = lanes_.find(lane.id);
-    if (it == lanes_.end()) {
+    Describe(lane, &now);
+    now.generation = generation_;
+    const auto [it, added] = lanes_.try_emplace(lane.id);
+    if (added) {
       delta.lanes.push_back(Patch(lane, 0));
     } else {
       // The first chunk that differs: the points before it are as sent.
@@ -100,13 +102,11 @@ ipm_road_mapper::VectorMapDelta VectorMapDeltaBuilder::Build(const VectorMap& ma
       const bool points_changed = first < now.points || now.points != before.points;
       if (points_changed || now.fields != before.fields) delta.lanes.push_back(Patch(lane, first));
     }
-    lanes[lane.id] = std::move(now);
+    std::swap(it->second, now);  // `now` keeps the old chunk vector's memory for the next lane
   }
-  delta.removed_marking_ids = Vanished(markings_, markings);
-  delta.removed_lane_ids = Vanished(lanes_, lanes);
+  delta.removed_marking_ids = EraseUnseen(&markings_, generation_);
+  delta.removed_lane_ids = EraseUnseen(&lanes_, generation_);
   delta.base_to_camera = IsometryToTransform(map.T_base_cam);
-  markings_ = std::move(markings);
-  lanes_ = std::move(lanes);
   return delta;
 }
 

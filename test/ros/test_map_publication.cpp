@@ -4,6 +4,7 @@
 // stay those of the shorter one.
 #include <gtest/gtest.h>
 #include <ros/serialization.h>
+#include <time.h>
 
 #include <cmath>
 #include <cstdio>
@@ -177,7 +178,14 @@ TEST(VectorMapDelta, AClientRebuildsTheMapFromTheDeltas) {
 // 20 m, and the window solve moves what lies within 40 m behind the vehicle.
 struct PublishCost {
   double bytes = 0.0, markers = 0.0, delta_elements = 0.0, full_bytes = 0.0;
+  double cpu_ms = 0.0;  // building the three messages (thread CPU; printed, not asserted)
 };
+
+double ThreadCpuMs() {
+  timespec t{};
+  clock_gettime(CLOCK_THREAD_CPUTIME_ID, &t);
+  return 1e3 * static_cast<double>(t.tv_sec) + 1e-6 * static_cast<double>(t.tv_nsec);
+}
 
 PublishCost MeasureDrive(double length_m, int path_max_poses) {
   MarkerBuilder markers(0.5, 16);
@@ -210,11 +218,14 @@ PublishCost MeasureDrive(double length_m, int path_max_poses) {
     pose.stamp = 0.25 * p;
     pose.T_map_base.translation() = Eigen::Vector3d(x, 0, 0);
     map.trajectory.push_back(pose);
+    const double cpu_start_ms = ThreadCpuMs();
     const auto marker_msg =
         markers.Build(map, "map", ros::Time(1.0), MarkerBuilder::Mode::kChanges);
     const auto delta = deltas.Build(map, "map", ros::Time(1.0));
     const auto path = ToPathMsg(map.trajectory, "map", path_max_poses, ros::Time(1.0));
+    const double cpu_ms = ThreadCpuMs() - cpu_start_ms;
     if (p < publishes - kMeasured) continue;
+    cost.cpu_ms += cpu_ms;
     cost.bytes += ros::serialization::serializationLength(marker_msg) +
                   ros::serialization::serializationLength(delta) +
                   ros::serialization::serializationLength(path);
@@ -227,6 +238,7 @@ PublishCost MeasureDrive(double length_m, int path_max_poses) {
   cost.markers /= kMeasured;
   cost.delta_elements /= kMeasured;
   cost.full_bytes /= kMeasured;
+  cost.cpu_ms /= kMeasured;
   return cost;
 }
 
@@ -236,10 +248,10 @@ TEST(PublicationCost, PerPublishWorkDoesNotGrowWithTheMap) {
   const PublishCost long_drive = MeasureDrive(3000.0, 100);
   std::printf(
       "per publish, 1 km -> 3 km: %.0f -> %.0f bytes, %.1f -> %.1f markers, %.1f -> %.1f delta "
-      "elements; a full ~vector_map %.0f -> %.0f bytes\n",
+      "elements, %.3f -> %.3f ms CPU; a full ~vector_map %.0f -> %.0f bytes\n",
       short_drive.bytes, long_drive.bytes, short_drive.markers, long_drive.markers,
-      short_drive.delta_elements, long_drive.delta_elements, short_drive.full_bytes,
-      long_drive.full_bytes);
+      short_drive.delta_elements, long_drive.delta_elements, short_drive.cpu_ms, long_drive.cpu_ms,
+      short_drive.full_bytes, long_drive.full_bytes);
   // The full map triples (the check that the drives differ), a publish does not grow.
   EXPECT_GT(long_drive.full_bytes, 2.5 * short_drive.full_bytes);
   EXPECT_LT(long_drive.bytes, 1.2 * short_drive.bytes);

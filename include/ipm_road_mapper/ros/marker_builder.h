@@ -21,9 +21,9 @@
 
 #include <cstddef>
 #include <cstdint>
-#include <map>
 #include <set>
 #include <string>
+#include <unordered_map>
 #include <utility>
 #include <vector>
 
@@ -70,11 +70,16 @@ class MarkerBuilder {
   visualization_msgs::MarkerArray Clear();
 
  private:
-  using MarkerKey = std::pair<std::string, int>;  // (namespace, id)
+  // What was sent of one marker: its element's fingerprint, and the last Build that drew it.
+  struct Sent {
+    std::size_t fingerprint = 0;
+    std::uint64_t generation = 0;
+  };
   double lane_sample_spacing_m_;
   std::size_t lane_chunk_segments_;
-  // Every marker on screen now, with the fingerprint of the element it draws.
-  std::map<MarkerKey, std::size_t> published_;
+  // Every marker on screen now, by (namespace index << 32 | id).
+  std::unordered_map<std::uint64_t, Sent> published_;
+  std::uint64_t generation_ = 0;  // Build calls so far
 };
 
 }  // namespace ipm_road_mapper

@@ -33,18 +33,26 @@ class VectorMapDeltaBuilder {
   ipm_road_mapper::VectorMapDelta Clear(const std::string& frame_id, const ros::Time& stamp);
 
  private:
-  // What was sent of one lane.
+  // What was sent of one marking, and the last Build whose map held it.
+  struct MarkingSent {
+    std::size_t fingerprint = 0;  // MessageFingerprint
+    std::uint64_t generation = 0;
+  };
+  // What was sent of one lane, and the last Build whose map held it.
   struct LaneSent {
     std::size_t fields = 0;           // MessageFingerprint without the control points
     std::vector<std::size_t> chunks;  // fingerprint per chunk of control points
     std::size_t points = 0;
+    std::uint64_t generation = 0;
   };
-  LaneSent Describe(const MapLane& lane) const;
+  // Fills *sent with what `lane`'s patch would depend on (generation untouched).
+  void Describe(const MapLane& lane, LaneSent* sent) const;
   ipm_road_mapper::VectorMapDelta NewDelta(const std::string& frame_id, const ros::Time& stamp);
 
   std::size_t lane_chunk_points_;
   std::uint32_t sequence_ = 0;
-  std::unordered_map<std::uint64_t, std::size_t> markings_;  // id -> MessageFingerprint
+  std::uint64_t generation_ = 0;  // Build calls so far
+  std::unordered_map<std::uint64_t, MarkingSent> markings_;
   std::unordered_map<std::uint64_t, LaneSent> lanes_;
 };
 
