@@ -176,7 +176,8 @@ void MappingWorker::RunFinish(Clock::time_point deadline) {
     session_.Finish(&update, budget_s);  // waiting frames decided, the last window solved
     ++map_version_;
     Export();
-    map = Latest()->FullMap();
+    // Exported whole, not from the frozen chunks: the final solve may move older poses.
+    map = ExportMap(true);
   }
   {
     std::lock_guard<std::mutex> lock(command_mutex_);
@@ -273,7 +274,7 @@ void MappingWorker::AfterUpdate(const SessionUpdate& update) {
   if (hooks_.on_update) hooks_.on_update(update, outputs);
 }
 
-std::shared_ptr<VectorMap> MappingWorker::ExportMap() {
+std::shared_ptr<VectorMap> MappingWorker::ExportMap(bool whole_trajectory) {
   const Mapper& mapper = *session_.mapper();
   const std::vector<FrameRecord>& frames = mapper.map().frames;
   const std::size_t mutable_frames =
@@ -283,9 +284,11 @@ std::shared_ptr<VectorMap> MappingWorker::ExportMap() {
   if (frames.size() > mutable_frames) {
     frozen_trajectory_.Extend(frames, frames.size() - mutable_frames);
   }
-  exported_prefix_ = frozen_trajectory_.chunks();
-  ExportOptions options;
-  options.max_trajectory_poses = frames.size() - frozen_trajectory_.size();
+  ExportOptions options;  // max_trajectory_poses 0: every pose
+  if (!whole_trajectory) {
+    exported_prefix_ = frozen_trajectory_.chunks();
+    options.max_trajectory_poses = frames.size() - frozen_trajectory_.size();
+  }
   auto map = std::make_shared<VectorMap>(mapper.ExportMap(options));
   map->frame_id = map_frame_.empty() ? "map" : map_frame_;
   map->metadata["source"] = "ipm_road_mapper/MapperNodelet " + node_name_;
@@ -311,7 +314,7 @@ MapperStatusSnapshot MappingWorker::Status() const {
 
 void MappingWorker::Export() {
   if (session_.started() && (map_version_ != exported_version_ || !exported_map_)) {
-    exported_map_ = ExportMap();
+    exported_map_ = ExportMap(false);
   }
   exported_version_ = map_version_;
   status_dirty_ = false;

@@ -110,8 +110,9 @@ class MappingWorker {
   // Runs the pending ~reset; true when the thread is to end (stop or finish done).
   bool RunCommands();
   void RunFinish(Clock::time_point deadline);
-  // The map with the trajectory after the frozen prefix (refreezes what no solve changes).
-  std::shared_ptr<VectorMap> ExportMap();
+  // The map with the trajectory after the frozen prefix (freezing more of what no window
+  // solve changes any more), or with the whole trajectory exported afresh.
+  std::shared_ptr<VectorMap> ExportMap(bool whole_trajectory);
   MapperStatusSnapshot Status() const;
 
   const MapperConfig config_;
