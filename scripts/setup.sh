@@ -12,7 +12,7 @@ with_rviz="${IRM_WITH_RVIZ:-0}"
 for arg in "$@"; do
   case "$arg" in
     --with-rviz) with_rviz=1 ;;
-    -h|--help) sed -n '2,10p' "$0"; exit 0 ;;
+    -h|--help) sed -n '2,8p' "$0" | sed 's/^# \{0,1\}//'; exit 0 ;;
     *) echo "[setup] unknown option: $arg (known: --with-rviz)" >&2; exit 2 ;;
   esac
 done
