@@ -1,7 +1,7 @@
 #!/usr/bin/env bash
 # Takes docs/rviz_demo.png: the demo drive mapped live by the nodelet (launch/demo.launch
 # rviz:=true), rviz/mapper.rviz under a virtual X server, captured near the end of the drive.
-# Installs rviz, xvfb and imagemagick on demand (no test needs them). Uses the drive of
+# Installs rviz, xvfb and imagemagick through `scripts/setup.sh --with-rviz` (no test needs them). Uses the drive of
 # scripts/demo.sh (out/demo/drive/drive.bag), generating it when missing.
 #   IRM_OUT=<dir>       demo output folder (default: out/demo)
 #   IRM_SHOT=<png>      output image (default: docs/rviz_demo.png)
@@ -15,16 +15,7 @@ at="${IRM_SHOT_AT:-0.8}"
 export PATH="/usr/bin:/bin:/usr/sbin:/sbin:$PATH"
 export ROS_HOME="$build/ros_home"
 
-missing=()
-for pkg in rviz xvfb imagemagick; do
-  [ "$(dpkg-query -W -f='${db:Status-Status}' "$pkg" 2>/dev/null)" = installed ] || missing+=("$pkg")
-done
-if [ ${#missing[@]} -gt 0 ]; then
-  echo "[shot] installing ${missing[*]}"
-  sudo_cmd=(); [ "$(id -u)" -ne 0 ] && sudo_cmd=(sudo)
-  DEBIAN_FRONTEND=noninteractive "${sudo_cmd[@]}" apt-get install -y -qq --no-install-recommends "${missing[@]}" >/dev/null
-fi
-bash "$repo/scripts/setup.sh"
+bash "$repo/scripts/setup.sh" --with-rviz  # rviz, Xvfb and ImageMagick too
 # shellcheck disable=SC1091
 source "$build/devel/setup.bash"
 bag="$out/drive/drive.bag"

@@ -3,7 +3,19 @@
 # builds the catkin package into .build/ at the repository root. A second run only
 # rebuilds what changed. Afterwards `source .build/devel/setup.bash` makes
 # `rosrun ipm_road_mapper ...` and `roslaunch ipm_road_mapper ...` work.
+#   --with-rviz (or IRM_WITH_RVIZ=1): also installs rviz, Xvfb and ImageMagick
+#   (scripts/debian-packages-rviz.txt): what `demo.launch rviz:=true` and
+#   scripts/rviz_screenshot.sh use. The default set-up stays without them.
 set -eo pipefail
+
+with_rviz="${IRM_WITH_RVIZ:-0}"
+for arg in "$@"; do
+  case "$arg" in
+    --with-rviz) with_rviz=1 ;;
+    -h|--help) sed -n '2,8p' "$0" | sed 's/^# \{0,1\}//'; exit 0 ;;
+    *) echo "[setup] unknown option: $arg (known: --with-rviz)" >&2; exit 2 ;;
+  esac
+done
 
 repo="$(cd "$(dirname "${BASH_SOURCE[0]}")/.." && pwd)"
 build="${IRM_BUILD_DIR:-$repo/.build}"
@@ -14,7 +26,9 @@ export PATH="/usr/bin:/bin:/usr/sbin:/sbin:$PATH"
 log() { printf '[setup] %s\n' "$*"; }
 
 # --- 1. Debian packages --------------------------------------------------------------
-mapfile -t wanted < <(grep -v '^\s*#' "$repo/scripts/debian-packages.txt" | sed '/^\s*$/d')
+package_lists=("$repo/scripts/debian-packages.txt")
+[ "$with_rviz" = 1 ] && package_lists+=("$repo/scripts/debian-packages-rviz.txt")
+mapfile -t wanted < <(cat "${package_lists[@]}" | grep -v '^\s*#' | sed '/^\s*$/d')
 missing=()
 for pkg in "${wanted[@]}"; do
   status=$(dpkg-query -W -f='${db:Status-Status}' "$pkg" 2>/dev/null || true)

@@ -32,6 +32,7 @@ std::string CheckFrameNameSet(const std::string& v) {
 RosOptions LoadRosOptions(OptionsReader reader) {
   RosOptions o;
   reader.Read<std::string>("mask_topic", &o.mask_topic, CheckNonEmpty);
+  reader.Read<std::string>("mask_transport", &o.mask_transport, CheckNonEmpty);
   reader.Read<std::string>("camera_info_topic", &o.camera_info_topic, CheckNonEmpty);
   reader.Read<std::string>("image_topic", &o.image_topic);
   reader.Read<std::string>("odom_topic", &o.odom_topic, CheckNonEmpty);
@@ -61,6 +62,7 @@ RosOptions LoadRosOptions(OptionsReader reader) {
   reader.Read<double>("debug_image_rate_hz", &o.debug_image_rate_hz, CheckPositive);
   reader.Read<int>("input_queue_size", &o.input_queue_size, CheckQueueSize);
   reader.Read<double>("marker_full_period_s", &o.marker_full_period_s, CheckPositive);
+  reader.Read<double>("vector_map_full_period_s", &o.vector_map_full_period_s, CheckPositive);
   reader.Read<double>("shutdown_budget_s", &o.shutdown_budget_s, CheckPositive);
   reader.Read<double>("autosave_period_s", &o.autosave_period_s, CheckNonNegative);
   reader.RejectUnknownKeys();
@@ -104,6 +106,7 @@ std::string ToString(const RosOptions& o) {
     << "ros.image_topic: " << or_default(o.image_topic, "(none)") << "\n"
     << "ros.odom_topic: " << o.odom_topic << "\n"
     << "ros.sync: " << o.sync << "\n"
+    << "ros.mask_transport: " << o.mask_transport << "\n"
     << "ros.publish_rate_hz: " << o.publish_rate_hz << "\n"
     << "ros.map_frame: " << o.map_frame << "\n"
     << "ros.odom_frame: " << o.odom_frame << "\n"
@@ -121,6 +124,7 @@ std::string ToString(const RosOptions& o) {
     << "ros.debug_image_rate_hz: " << o.debug_image_rate_hz << "\n"
     << "ros.input_queue_size: " << o.input_queue_size << "\n"
     << "ros.marker_full_period_s: " << o.marker_full_period_s << "\n"
+    << "ros.vector_map_full_period_s: " << o.vector_map_full_period_s << "\n"
     << "ros.shutdown_budget_s: " << o.shutdown_budget_s << "\n"
     << "ros.autosave_period_s: " << o.autosave_period_s
     << (o.autosave_period_s > 0.0 ? "" : " (off: saved at shutdown only)") << "\n";

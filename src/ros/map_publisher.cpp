@@ -9,9 +9,12 @@
 namespace ipm_road_mapper {
 
 MapPublisher::MapPublisher(ros::NodeHandle& private_nh, int path_max_poses,
-                           double marker_full_period_s)
-    : path_max_poses_(path_max_poses), marker_full_period_(marker_full_period_s) {
+                           double marker_full_period_s, double vector_map_full_period_s)
+    : path_max_poses_(path_max_poses),
+      marker_full_period_(marker_full_period_s),
+      vector_map_full_period_(vector_map_full_period_s) {
   vector_map_pub_ = private_nh.advertise<ipm_road_mapper::VectorMapMsg>("vector_map", 1, true);
+  delta_pub_ = private_nh.advertise<ipm_road_mapper::VectorMapDelta>("vector_map_delta", 10);
   // A new subscriber gets the latched last message (maybe a delta), then the full set.
   const ros::SubscriberStatusCallback on_connect = [this](const ros::SingleSubscriberPublisher&) {
     new_marker_subscriber_ = true;
@@ -21,26 +24,50 @@ MapPublisher::MapPublisher(ros::NodeHandle& private_nh, int path_max_poses,
   path_pub_ = private_nh.advertise<nav_msgs::Path>("corrected_path", 1, true);
 }
 
-void MapPublisher::Publish(const VectorMap& map, const std::string& map_frame,
-                           const std::string& base_frame, const std::string& refined_camera_frame,
-                           const ros::Time& stamp, bool map_changed) {
+PublishCounts MapPublisher::Publish(const VectorMap& map, const std::string& map_frame,
+                                    const std::string& base_frame,
+                                    const std::string& refined_camera_frame, const ros::Time& stamp,
+                                    bool map_changed) {
   std::lock_guard<std::mutex> lock(mutex_);
+  PublishCounts counts;
   const ros::WallTime now = ros::WallTime::now();
   const bool full = new_marker_subscriber_.exchange(false) || last_full_markers_.isZero() ||
                     now - last_full_markers_ >= marker_full_period_;
   if (full) last_full_markers_ = now;
   const visualization_msgs::MarkerArray markers = markers_.Build(
       map, map_frame, stamp, full ? MarkerBuilder::Mode::kFull : MarkerBuilder::Mode::kChanges);
-  if (!markers.markers.empty()) markers_pub_.publish(markers);
-  if (!map_changed) return;
-  vector_map_pub_.publish(ToVectorMapMsg(map, map_frame, stamp));
-  path_pub_.publish(ToPathMsg(map.trajectory, map_frame, path_max_poses_, stamp));
-  const bool changed = !last_T_base_cam_ || !last_T_base_cam_->isApprox(map.T_base_cam, 1e-12);
-  if (changed) {
-    static_tf_.sendTransform(
-        IsometryToTransformStamped(map.T_base_cam, stamp, base_frame, refined_camera_frame));
-    last_T_base_cam_ = map.T_base_cam;
+  if (!markers.markers.empty()) {
+    markers_pub_.publish(markers);
+    counts.markers = markers.markers.size();
+    counts.serialized_bytes += ros::serialization::serializationLength(markers);
   }
+  if (map_changed) {
+    full_map_stale_ = true;
+    const ipm_road_mapper::VectorMapDelta delta = deltas_.Build(map, map_frame, stamp);
+    delta_pub_.publish(delta);
+    counts.delta_elements = delta.markings.size() + delta.lanes.size() +
+                            delta.removed_marking_ids.size() + delta.removed_lane_ids.size();
+    counts.serialized_bytes += ros::serialization::serializationLength(delta);
+    const nav_msgs::Path path = ToPathMsg(map.trajectory, map_frame, path_max_poses_, stamp);
+    path_pub_.publish(path);
+    counts.path_poses = path.poses.size();
+    counts.serialized_bytes += ros::serialization::serializationLength(path);
+    const bool moved = !last_T_base_cam_ || !last_T_base_cam_->isApprox(map.T_base_cam, 1e-12);
+    if (moved) {
+      static_tf_.sendTransform(
+          IsometryToTransformStamped(map.T_base_cam, stamp, base_frame, refined_camera_frame));
+      last_T_base_cam_ = map.T_base_cam;
+    }
+  }
+  if (FullMapDueLocked(now)) {
+    last_full_map_ = now;
+    full_map_stale_ = false;
+    const ipm_road_mapper::VectorMapMsg full_map = ToVectorMapMsg(map, map_frame, stamp);
+    vector_map_pub_.publish(full_map);
+    counts.full_elements = full_map.markings.size() + full_map.lanes.size();
+    counts.serialized_bytes += ros::serialization::serializationLength(full_map);
+  }
+  return counts;
 }
 
 bool MapPublisher::full_markers_due() const {
@@ -49,10 +76,23 @@ bool MapPublisher::full_markers_due() const {
          ros::WallTime::now() - last_full_markers_ >= marker_full_period_;
 }
 
+bool MapPublisher::full_map_due() const {
+  std::lock_guard<std::mutex> lock(mutex_);
+  return FullMapDueLocked(ros::WallTime::now());
+}
+
+bool MapPublisher::FullMapDueLocked(const ros::WallTime& now) const {
+  return full_map_stale_ &&
+         (last_full_map_.isZero() || now - last_full_map_ >= vector_map_full_period_);
+}
+
 void MapPublisher::Clear(const std::string& map_frame, const ros::Time& stamp) {
   std::lock_guard<std::mutex> lock(mutex_);
   VectorMap empty;
   vector_map_pub_.publish(ToVectorMapMsg(empty, map_frame, stamp));
+  last_full_map_ = ros::WallTime::now();
+  full_map_stale_ = false;
+  delta_pub_.publish(deltas_.Clear(map_frame, stamp));
   markers_pub_.publish(markers_.Clear());
   path_pub_.publish(ToPathMsg({}, map_frame, path_max_poses_, stamp));
 }

@@ -90,7 +90,7 @@ void MapSaver::Autosave() {
     std::lock_guard<std::mutex> lock(mutex_);
     if (saved_any_ && snapshot->map_version == saved_version_) return;  // unchanged
   }
-  const MapSaveResult result = Save(*snapshot->map, snapshot->resets);
+  const MapSaveResult result = Save(*snapshot->FullMap(), snapshot->resets);
   if (result.ok) {
     std::lock_guard<std::mutex> lock(mutex_);
     saved_any_ = true;

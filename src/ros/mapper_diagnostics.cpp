@@ -73,18 +73,34 @@ void FillFrameStatus(const MapperStatusSnapshot& now, const MapperStatusSnapshot
   s->add("inputs dropped (queue full): frames", now.inputs_dropped[0]);
   s->add("inputs dropped (queue full): odometry", now.inputs_dropped[1]);
   s->add("inputs dropped (queue full): images", now.inputs_dropped[2]);
+  s->add("subscriber queue: masks", now.mask_queue_size);
+  s->add("subscriber queue: odometry", now.odom_queue_size);
+  s->add("masks lost before the callback (seq gaps)", now.mask_gaps.lost_by_seq);
+  s->add("masks lost before the callback (stamp gaps)", now.mask_gaps.lost_by_stamp);
+  s->add("odometry lost before the callback (seq gaps)", now.odometry_gaps.lost_by_seq);
+  s->add("odometry lost before the callback (stamp gaps)", now.odometry_gaps.lost_by_stamp);
+  s->add("input restarts (stamps went back)", now.mask_gaps.restarts);
   s->add("publishes", now.publishes);
   s->addf("publish_cpu_ms", "%.3f", now.publish_cpu_last_ms);
   s->addf("publish_cpu_ms mean", "%.3f", now.publish_cpu_mean_ms);
   s->addf("publish_cpu_ms max", "%.3f", now.publish_cpu_max_ms);
+  s->add("publish last: markers", now.publish_last_markers);
+  s->add("publish last: delta elements", now.publish_last_delta_elements);
+  s->add("publish last: bytes", now.publish_last_bytes);
   const std::uint64_t new_used = used - std::min(used, previous.counters.frames_used);
   const std::uint64_t new_skipped =
       skipped_total - std::min(skipped_total, Total(AllSkipped(previous)));
   const auto dropped = [](const MapperStatusSnapshot& x) {
     return x.inputs_dropped[0] + x.inputs_dropped[1] + x.inputs_dropped[2];
   };
+  const auto lost = [](const MapperStatusSnapshot& x) {
+    return x.mask_gaps.lost() + x.odometry_gaps.lost();
+  };
   if (dropped(now) > dropped(previous)) {
     s->summary(DiagnosticStatus::WARN, "inputs dropped: the mapping thread falls behind");
+  } else if (lost(now) > lost(previous)) {
+    s->summary(DiagnosticStatus::WARN,
+               "masks or odometry lost before the callbacks (subscriber queue full?)");
   } else if (new_used == 0 && new_skipped > 0) {
     s->summary(DiagnosticStatus::WARN, "frames skipped, none used");
   } else if (new_skipped > 0) {
@@ -113,6 +129,13 @@ void FillOptimizerStatus(const MapperStatusSnapshot& now, const MapperStatusSnap
           t.empty() ? 0.0 : 1e3 * *std::max_element(t.begin(), t.end()));
   if (!now.backend_enabled) {
     s->summary(DiagnosticStatus::OK, "disabled (front end only)");
+  } else if (b.dropped_queue_full > previous.backend.dropped_queue_full) {
+    // Windows come faster than they are solved (e.g. a bag played faster than real time):
+    // the dropped windows' lanes and poses go unrefined, lanes fragment.
+    s->summary(DiagnosticStatus::WARN,
+               "the optimizer falls behind: " +
+                   std::to_string(b.dropped_queue_full - previous.backend.dropped_queue_full) +
+                   " window(s) dropped since the last update (input faster than the solves)");
   } else if (b.unusable > previous.backend.unusable) {
     s->summary(DiagnosticStatus::WARN, "a window solve was unusable");
   } else {

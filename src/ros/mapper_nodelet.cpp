@@ -8,6 +8,7 @@
 #include <cstdio>
 #include <limits>
 #include <pluginlib/class_list_macros.hpp>
+#include <stdexcept>
 #include <utility>
 
 #include "ipm_road_mapper/pipeline/map_files.h"
@@ -61,8 +62,8 @@ void MapperNodelet::onInit() {
   }
   SetUpOutputs();
   SetUpInputs();
-  NODELET_INFO("%s: waiting for %s (+ %s) and %s; %s sync", node_name_.c_str(),
-               config_.ros.mask_topic.c_str(), config_.ros.camera_info_topic.c_str(),
+  NODELET_INFO("%s: waiting for masks through %s (+ %s) and %s; %s sync", node_name_.c_str(),
+               mask_sub_->description().c_str(), config_.ros.camera_info_topic.c_str(),
                config_.ros.odom_topic.c_str(), config_.ros.sync.c_str());
 }
 
@@ -94,7 +95,8 @@ void MapperNodelet::SetUpOutputs() {
   ros::NodeHandle output_nh(private_nh);  // timers and services on our own queue
   output_nh.setCallbackQueue(&output_queue_);
   map_publisher_ = std::make_unique<MapPublisher>(private_nh, config_.ros.path_max_poses,
-                                                  config_.ros.marker_full_period_s);
+                                                  config_.ros.marker_full_period_s,
+                                                  config_.ros.vector_map_full_period_s);
   pose_publisher_ = std::make_unique<PosePublisher>(private_nh, config_.ros.publish_map_to_odom);
   debug_image_ = std::make_unique<DebugImagePublisher>(
       nh, private_nh, config_.ros.image_topic, config_.mapper, classes_,
@@ -119,10 +121,19 @@ void MapperNodelet::SetUpInputs() {
   const RosOptions& topics = config_.ros;
   const int queue = config_.ros.sync_queue_size;
   tf_listener_ = std::make_unique<tf2_ros::TransformListener>(*tf_buffer_, nh);
-  mask_sub_.subscribe(nh, topics.mask_topic, queue);
+  try {
+    mask_sub_ = std::make_unique<MaskInput>(nh, topics.mask_topic, topics.mask_transport, queue);
+  } catch (const std::invalid_argument& e) {
+    NODELET_FATAL("%s: %s", node_name_.c_str(), e.what());
+    throw;
+  }
   info_sub_.subscribe(nh, topics.camera_info_topic, queue);
-  mask_sub_.registerCallback(boost::function<void(const sensor_msgs::ImageConstPtr&)>(
-      [this](const sensor_msgs::ImageConstPtr&) { diagnostics_->Count(MapperInput::kMask); }));
+  mask_sub_->registerCallback(boost::function<void(const sensor_msgs::ImageConstPtr&)>(
+      [this](const sensor_msgs::ImageConstPtr& mask) {
+        diagnostics_->Count(MapperInput::kMask);
+        std::lock_guard<std::mutex> lock(stats_mutex_);
+        mask_gaps_.Add(mask->header.seq, ToSeconds(mask->header.stamp));
+      }));
   info_sub_.registerCallback(boost::function<void(const sensor_msgs::CameraInfoConstPtr&)>(
       [this](const sensor_msgs::CameraInfoConstPtr&) {
         diagnostics_->Count(MapperInput::kCameraInfo);
@@ -133,11 +144,11 @@ void MapperNodelet::SetUpInputs() {
     ApproximatePolicy policy(queue);
     policy.setMaxIntervalDuration(ros::Duration(config_.ros.approximate_sync_max_interval_s));
     approximate_sync_ = std::make_unique<message_filters::Synchronizer<ApproximatePolicy>>(
-        std::as_const(policy), mask_sub_, info_sub_);  // const: the policy constructor
+        std::as_const(policy), *mask_sub_, info_sub_);  // const: the policy constructor
     approximate_sync_->registerCallback(boost::bind(&MapperNodelet::OnFrame, this, _1, _2));
   } else {
     exact_sync_ = std::make_unique<message_filters::Synchronizer<ExactPolicy>>(
-        ExactPolicy(queue), mask_sub_, info_sub_);
+        ExactPolicy(queue), *mask_sub_, info_sub_);
     exact_sync_->registerCallback(boost::bind(&MapperNodelet::OnFrame, this, _1, _2));
   }
   odom_sub_ = nh.subscribe(topics.odom_topic, config_.ros.odom_queue_size,
@@ -166,6 +177,10 @@ void MapperNodelet::OnFrame(const sensor_msgs::ImageConstPtr& mask_msg,
 void MapperNodelet::OnOdometry(const nav_msgs::OdometryConstPtr& msg) {
   const auto start = std::chrono::steady_clock::now();
   diagnostics_->Count(MapperInput::kOdometry);
+  {
+    std::lock_guard<std::mutex> lock(stats_mutex_);
+    odometry_gaps_.Add(msg->header.seq, ToSeconds(msg->header.stamp));
+  }
   if (shutting_down_) return;
   OdometryItem odometry;
   odometry.frame_id = msg->header.frame_id;
@@ -212,15 +227,16 @@ void MapperNodelet::OnPublishTimer() {
   const std::shared_ptr<const MapSnapshot> snapshot = worker_->Latest();
   if (!snapshot->map) return;
   const bool changed = snapshot->map_version != published_version_;
-  if (!changed && !map_publisher_->full_markers_due()) return;
+  if (!changed && !map_publisher_->full_markers_due() && !map_publisher_->full_map_due()) return;
   published_version_ = snapshot->map_version;
   const double cpu_start_ms = ThreadCpuMs();
-  map_publisher_->Publish(*snapshot->map, snapshot->map_frame, config_.mapper.input.base_frame,
-                          snapshot->refined_camera_frame, FromSeconds(snapshot->newest_frame_stamp),
-                          changed);
+  const PublishCounts counts = map_publisher_->Publish(
+      *snapshot->map, snapshot->map_frame, config_.mapper.input.base_frame,
+      snapshot->refined_camera_frame, FromSeconds(snapshot->newest_frame_stamp), changed);
   const double cpu_ms = ThreadCpuMs() - cpu_start_ms;
   std::lock_guard<std::mutex> lock(stats_mutex_);
   ++publishes_;
+  publish_last_ = counts;
   publish_cpu_last_ms_ = cpu_ms;
   publish_cpu_total_ms_ += cpu_ms;
   publish_cpu_max_ms_ = std::max(publish_cpu_max_ms_, cpu_ms);
@@ -235,7 +251,8 @@ bool MapperNodelet::OnSaveMap(ipm_road_mapper::SaveMap::Request& request,
   } else if (!snapshot->map) {
     response.message = "no map yet: " + snapshot->status.extrinsic_status;
   } else {
-    const VectorMap& map = *snapshot->map;
+    const std::shared_ptr<const VectorMap> full = snapshot->FullMap();
+    const VectorMap& map = *full;
     const MapFilePaths paths = MapFilePathsFor(request.path);
     try {
       SaveMapFiles(map, config_.geo_origin, paths);
@@ -280,6 +297,13 @@ MapperStatusSnapshot MapperNodelet::Snapshot() {
   s.publish_cpu_last_ms = publish_cpu_last_ms_;
   s.publish_cpu_mean_ms = publishes_ ? publish_cpu_total_ms_ / publishes_ : 0.0;
   s.publish_cpu_max_ms = publish_cpu_max_ms_;
+  s.publish_last_markers = publish_last_.markers;
+  s.publish_last_delta_elements = publish_last_.delta_elements;
+  s.publish_last_bytes = publish_last_.serialized_bytes;
+  s.mask_queue_size = config_.ros.sync_queue_size;
+  s.odom_queue_size = config_.ros.odom_queue_size;
+  s.mask_gaps = mask_gaps_.stats();
+  s.odometry_gaps = odometry_gaps_.stats();
   if (saver_) s.save = saver_->status();
   return s;
 }
@@ -300,7 +324,7 @@ void MapperNodelet::Shutdown() {
   save_srv_.shutdown();
   reset_srv_.shutdown();
   odom_sub_.shutdown();
-  mask_sub_.unsubscribe();
+  if (mask_sub_) mask_sub_->Shutdown();
   info_sub_.unsubscribe();
   if (debug_image_) debug_image_->Shutdown();
   if (output_spinner_) output_spinner_->stop();  // joins the output thread

@@ -14,7 +14,19 @@ MappingWorker::Clock::duration Period(double rate_hz) {
   return std::chrono::duration_cast<MappingWorker::Clock::duration>(Seconds(1.0 / rate_hz));
 }
 
+// Poses per frozen trajectory chunk.
+constexpr std::size_t kTrajectoryChunkPoses = 1000;
+// Frames a solve may still change: a window and its context frames are far fewer.
+constexpr std::size_t kMutableFramesPerWindowFrame = 10;
+
 }  // namespace
+
+std::shared_ptr<const VectorMap> MapSnapshot::FullMap() const {
+  if (!map) return nullptr;
+  auto full = std::make_shared<VectorMap>(*map);
+  full->trajectory = FullTrajectory(trajectory_prefix, map->trajectory);
+  return full;
+}
 
 MappingWorker::MappingWorker(const MapperConfig& config, const ClassTable& classes,
                              std::string node_name, TransformLookup lookup, Hooks hooks)
@@ -25,6 +37,7 @@ MappingWorker::MappingWorker(const MapperConfig& config, const ClassTable& class
       export_period_(Period(config.ros.publish_rate_hz)),
       overlay_period_(Period(config.ros.debug_image_rate_hz)),
       session_(config.mapper, classes, config.ros.odometry_wait_s),
+      frozen_trajectory_(kTrajectoryChunkPoses),
       queue_(static_cast<std::size_t>(config.ros.input_queue_size)),
       latest_(std::make_shared<const MapSnapshot>()) {
   next_export_ = Clock::now();
@@ -96,7 +109,7 @@ std::shared_ptr<const VectorMap> MappingWorker::Finish(Clock::time_point deadlin
   *finished = command_done_.wait_until(lock, deadline, [this] { return finish_done_; });
   if (*finished) return finished_map_;
   lock.unlock();
-  return Latest()->map;
+  return Latest()->FullMap();
 }
 
 void MappingWorker::Stop() {
@@ -136,6 +149,7 @@ bool MappingWorker::RunCommands() {
   }
   if (reset) {
     session_.Reset();
+    frozen_trajectory_.Clear();
     ++map_version_;
     ++generation_;
     Export();  // the services and timers see the empty map at once
@@ -162,7 +176,8 @@ void MappingWorker::RunFinish(Clock::time_point deadline) {
     session_.Finish(&update, budget_s);  // waiting frames decided, the last window solved
     ++map_version_;
     Export();
-    map = exported_map_;
+    // Exported whole, not from the frozen chunks: the final solve may move older poses.
+    map = ExportMap(true);
   }
   {
     std::lock_guard<std::mutex> lock(command_mutex_);
@@ -268,8 +283,22 @@ void MappingWorker::AfterUpdate(const SessionUpdate& update) {
   if (hooks_.on_update) hooks_.on_update(update, outputs);
 }
 
-std::shared_ptr<VectorMap> MappingWorker::ExportMap() const {
-  auto map = std::make_shared<VectorMap>(session_.mapper()->ExportMap());
+std::shared_ptr<VectorMap> MappingWorker::ExportMap(bool whole_trajectory) {
+  const Mapper& mapper = *session_.mapper();
+  const std::vector<FrameRecord>& frames = mapper.map().frames;
+  const std::size_t mutable_frames =
+      std::max(static_cast<std::size_t>(config_.ros.path_max_poses),
+               kMutableFramesPerWindowFrame *
+                   static_cast<std::size_t>(config_.mapper.backend.window_frames));
+  if (frames.size() > mutable_frames) {
+    frozen_trajectory_.Extend(frames, frames.size() - mutable_frames);
+  }
+  ExportOptions options;  // max_trajectory_poses 0: every pose
+  if (!whole_trajectory) {
+    exported_prefix_ = frozen_trajectory_.chunks();
+    options.max_trajectory_poses = frames.size() - frozen_trajectory_.size();
+  }
+  auto map = std::make_shared<VectorMap>(mapper.ExportMap(options));
   map->frame_id = config_.ros.map_frame;
   map->metadata["source"] = "ipm_road_mapper/MapperNodelet " + node_name_;
   map->metadata["extrinsic_source"] = extrinsic_status_;
@@ -296,12 +325,13 @@ MapperStatusSnapshot MappingWorker::Status() const {
 
 void MappingWorker::Export() {
   if (session_.started() && (map_version_ != exported_version_ || !exported_map_)) {
-    exported_map_ = ExportMap();
+    exported_map_ = ExportMap(false);
   }
   exported_version_ = map_version_;
   status_dirty_ = false;
   auto snapshot = std::make_shared<MapSnapshot>();
   snapshot->map = exported_map_;
+  snapshot->trajectory_prefix = exported_prefix_;
   snapshot->map_version = map_version_;
   snapshot->resets = generation_;
   snapshot->newest_frame_stamp = newest_frame_stamp_;

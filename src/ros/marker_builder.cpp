@@ -1,5 +1,6 @@
 #include "ipm_road_mapper/ros/marker_builder.h"
 
+#include <algorithm>
 #include <array>
 #include <cstdint>
 #include <exception>
@@ -7,15 +8,20 @@
 #include <vector>
 
 #include "ipm_road_mapper/core/geometry/catmull_rom_spline.h"
+#include "ipm_road_mapper/ros/element_fingerprint.h"
 #include "ipm_road_mapper/ros/msg_conversion.h"
 
 namespace ipm_road_mapper {
 namespace {
 
-constexpr const char* kLaneNs = "lanes";
-constexpr const char* kControlPointNs = "lane_control_points";
-constexpr const char* kMarkingNs = "markings";
-constexpr const char* kLabelNs = "marking_labels";
+// The marker namespaces, by index (a marker's key is its namespace index and id).
+constexpr std::array<const char*, 4> kNamespaces = {"lanes", "lane_control_points", "markings",
+                                                    "marking_labels"};
+constexpr std::size_t kLaneNs = 0, kControlPointNs = 1, kMarkingNs = 2, kLabelNs = 3;
+
+std::uint64_t Key(std::size_t ns, int id) {
+  return (static_cast<std::uint64_t>(ns) << 32) | static_cast<std::uint32_t>(id);
+}
 
 std_msgs::ColorRGBA Rgba(float r, float g, float b, float a = 1.0f) {
   std_msgs::ColorRGBA c;
@@ -42,38 +48,17 @@ visualization_msgs::Marker NewMarker(const std::string& ns, int id, int type,
   return m;
 }
 
-// Points along the lane's curve; the control points themselves when the spline cannot be
-// built (fewer than 4 or non-finite points).
-std::vector<Eigen::Vector3d> LaneSamples(const MapLane& lane, double spacing_m) {
+// Points along the curve of control points [first, last) (segments first .. last - 4); the
+// control points themselves when no spline can be built (fewer than 4 or non-finite points).
+std::vector<Eigen::Vector3d> CurveSamples(const std::vector<Eigen::Vector3d>& control_points,
+                                          std::size_t first, std::size_t last, double spacing_m) {
+  const std::vector<Eigen::Vector3d> part(control_points.begin() + first,
+                                          control_points.begin() + last);
   try {
-    return CatmullRomSpline(lane.control_points_map).SampleByArcLength(spacing_m);
+    return CatmullRomSpline(part).SampleByArcLength(spacing_m);
   } catch (const std::exception&) {
-    return lane.control_points_map;
+    return part;
   }
-}
-
-void HashCombine(std::size_t* seed, std::size_t value) {
-  *seed ^= value + 0x9e3779b97f4a7c15ull + (*seed << 6) + (*seed >> 2);
-}
-
-void HashPoint(std::size_t* seed, const Eigen::Vector3d& p) {
-  for (int i = 0; i < 3; ++i) HashCombine(seed, std::hash<double>()(p[i]));
-}
-
-// What a lane's markers depend on: class and control points.
-std::size_t Fingerprint(const MapLane& lane) {
-  std::size_t seed = std::hash<int>()(lane.class_id);
-  HashCombine(&seed, std::hash<std::string>()(lane.class_name));
-  for (const Eigen::Vector3d& c : lane.control_points_map) HashPoint(&seed, c);
-  return seed;
-}
-
-// What a marking's markers depend on: class and corners.
-std::size_t Fingerprint(const MapMarking& marking) {
-  std::size_t seed = std::hash<int>()(marking.class_id);
-  HashCombine(&seed, std::hash<std::string>()(marking.class_name));
-  for (const Eigen::Vector3d& c : marking.corners_map) HashPoint(&seed, c);
-  return seed;
 }
 
 }  // namespace
@@ -98,80 +83,110 @@ std_msgs::ColorRGBA ClassColor(int class_id, const std::string& class_name) {
   return Rgba(c[0], c[1], c[2]);
 }
 
-MarkerBuilder::MarkerBuilder(double lane_sample_spacing_m)
-    : lane_sample_spacing_m_(lane_sample_spacing_m > 0.0 ? lane_sample_spacing_m : 0.5) {}
+int LaneChunkMarkerId(std::uint64_t lane_id, std::size_t chunk) {
+  return static_cast<int>(((lane_id & 0x1fffffu) << 10) | (chunk & 0x3ffu));
+}
+
+std::vector<LaneChunk> LaneChunks(std::size_t control_points, std::size_t chunk_segments) {
+  chunk_segments = std::max<std::size_t>(chunk_segments, 1);
+  if (control_points < 4) return {{0, 0, control_points, 0, control_points}};
+  const std::size_t segments = control_points - 3;
+  std::vector<LaneChunk> chunks;
+  for (std::size_t first = 0; first < segments; first += chunk_segments) {
+    const std::size_t end = std::min(first + chunk_segments, segments);
+    const bool last = end == segments;
+    chunks.push_back({chunks.size(), first, end + 3, first, last ? control_points : end});
+  }
+  return chunks;
+}
+
+MarkerBuilder::MarkerBuilder(double lane_sample_spacing_m, std::size_t lane_chunk_segments)
+    : lane_sample_spacing_m_(lane_sample_spacing_m > 0.0 ? lane_sample_spacing_m : 0.5),
+      lane_chunk_segments_(std::max<std::size_t>(lane_chunk_segments, 1)) {}
 
 visualization_msgs::MarkerArray MarkerBuilder::Build(const VectorMap& map,
                                                      const std::string& frame_id,
                                                      const ros::Time& stamp, Mode mode) {
   using visualization_msgs::Marker;
   visualization_msgs::MarkerArray out;
-  std::map<MarkerKey, std::size_t> now;
+  ++generation_;
   std::size_t fingerprint = 0;
-  auto add = [&](Marker marker) {
-    now[{marker.ns, marker.id}] = fingerprint;
+  auto add = [&](std::size_t ns, Marker marker) {
+    published_[Key(ns, marker.id)] = {fingerprint, generation_};
     out.markers.push_back(std::move(marker));
   };
   // kChanges: an element drawn before with the same fingerprint keeps its markers as sent.
-  auto unchanged = [&](const char* ns_a, const char* ns_b, int id) {
+  auto unchanged = [&](std::size_t ns_a, std::size_t ns_b, int id) {
     if (mode != Mode::kChanges) return false;
     bool any = false, same = true;
-    for (const char* ns : {ns_a, ns_b}) {
-      const auto it = published_.find({ns, id});
+    for (const std::size_t ns : {ns_a, ns_b}) {
+      const auto it = published_.find(Key(ns, id));
       if (it == published_.end()) continue;
       any = true;
-      same = same && it->second == fingerprint;
+      same = same && it->second.fingerprint == fingerprint;
     }
     if (!any || !same) return false;
-    for (const char* ns : {ns_a, ns_b}) {
-      const auto it = published_.find({ns, id});
-      if (it != published_.end()) now.insert(*it);
+    for (const std::size_t ns : {ns_a, ns_b}) {
+      const auto it = published_.find(Key(ns, id));
+      if (it != published_.end()) it->second.generation = generation_;
     }
     return true;
   };
   for (const MapLane& lane : map.lanes) {
-    const int id = MarkerId(lane.id);
-    fingerprint = Fingerprint(lane);
-    if (unchanged(kLaneNs, kControlPointNs, id)) continue;
+    const std::vector<Eigen::Vector3d>& cps = lane.control_points_map;
     const std_msgs::ColorRGBA color = ClassColor(lane.class_id, lane.class_name);
-    Marker line = NewMarker(kLaneNs, id, Marker::LINE_STRIP, frame_id, stamp);
-    line.scale.x = 0.15;  // line width, m (a painted lane line)
-    line.color = color;
-    for (const Eigen::Vector3d& p : LaneSamples(lane, lane_sample_spacing_m_)) {
-      line.points.push_back(ToPointMsg(p));
+    for (const LaneChunk& chunk : LaneChunks(cps.size(), lane_chunk_segments_)) {
+      const int id = LaneChunkMarkerId(lane.id, chunk.index);
+      fingerprint = GeometryFingerprint(lane, chunk.curve_first, chunk.curve_last);
+      if (unchanged(kLaneNs, kControlPointNs, id)) continue;
+      Marker line = NewMarker(kNamespaces[kLaneNs], id, Marker::LINE_STRIP, frame_id, stamp);
+      line.scale.x = 0.15;  // line width, m (a painted lane line)
+      line.color = color;
+      for (const Eigen::Vector3d& p :
+           CurveSamples(cps, chunk.curve_first, chunk.curve_last, lane_sample_spacing_m_)) {
+        line.points.push_back(ToPointMsg(p));
+      }
+      if (line.points.size() >= 2) add(kLaneNs, std::move(line));
+      Marker points =
+          NewMarker(kNamespaces[kControlPointNs], id, Marker::SPHERE_LIST, frame_id, stamp);
+      points.scale.x = points.scale.y = points.scale.z = 0.3;
+      points.color = Rgba(color.r * 0.6f, color.g * 0.6f, color.b * 0.6f + 0.4f);
+      for (std::size_t i = chunk.points_first; i < chunk.points_last; ++i) {
+        points.points.push_back(ToPointMsg(cps[i]));
+      }
+      if (!points.points.empty()) add(kControlPointNs, std::move(points));
     }
-    if (line.points.size() >= 2) add(line);
-    Marker points = NewMarker(kControlPointNs, id, Marker::SPHERE_LIST, frame_id, stamp);
-    points.scale.x = points.scale.y = points.scale.z = 0.3;
-    points.color = Rgba(color.r * 0.6f, color.g * 0.6f, color.b * 0.6f + 0.4f);
-    for (const Eigen::Vector3d& c : lane.control_points_map) points.points.push_back(ToPointMsg(c));
-    if (!points.points.empty()) add(points);
   }
   for (const MapMarking& marking : map.markings) {
     const int id = MarkerId(marking.id);
-    fingerprint = Fingerprint(marking);
+    fingerprint = GeometryFingerprint(marking);
     if (unchanged(kMarkingNs, kLabelNs, id)) continue;
     const std_msgs::ColorRGBA color = ClassColor(marking.class_id, marking.class_name);
-    Marker outline = NewMarker(kMarkingNs, id, Marker::LINE_STRIP, frame_id, stamp);
+    Marker outline = NewMarker(kNamespaces[kMarkingNs], id, Marker::LINE_STRIP, frame_id, stamp);
     outline.scale.x = 0.08;
     outline.color = color;
     for (int i = 0; i <= 4; ++i) outline.points.push_back(ToPointMsg(marking.corners_map[i % 4]));
-    add(outline);
-    Marker label = NewMarker(kLabelNs, id, Marker::TEXT_VIEW_FACING, frame_id, stamp);
+    add(kMarkingNs, std::move(outline));
+    Marker label = NewMarker(kNamespaces[kLabelNs], id, Marker::TEXT_VIEW_FACING, frame_id, stamp);
     label.pose.position = ToPointMsg(marking.Center() + Eigen::Vector3d(0.0, 0.0, 0.5));
     label.scale.z = 0.6;  // text height, m
     label.color = color;
     label.text = marking.class_name.empty() ? "class " + std::to_string(marking.class_id)
                                             : marking.class_name;
-    add(label);
+    add(kLabelNs, std::move(label));
   }
-  for (const auto& [key, unused] : published_) {
-    if (now.count(key)) continue;
-    Marker gone = NewMarker(key.first, key.second, Marker::LINE_STRIP, frame_id, stamp);
+  // What this map no longer draws: deleted on screen and forgotten.
+  for (auto it = published_.begin(); it != published_.end();) {
+    if (it->second.generation == generation_) {
+      ++it;
+      continue;
+    }
+    Marker gone = NewMarker(kNamespaces[it->first >> 32], static_cast<int>(it->first & 0xffffffffu),
+                            Marker::LINE_STRIP, frame_id, stamp);
     gone.action = Marker::DELETE;
     out.markers.push_back(gone);
+    it = published_.erase(it);
   }
-  published_ = std::move(now);
   return out;
 }
 

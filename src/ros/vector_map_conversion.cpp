@@ -15,37 +15,42 @@ ros::Time SafeTime(double seconds) {
 
 }  // namespace
 
+ipm_road_mapper::MarkingPolygon ToMarkingMsg(const MapMarking& marking) {
+  ipm_road_mapper::MarkingPolygon m;
+  m.id = marking.id;
+  m.class_id = marking.class_id;
+  m.class_name = marking.class_name;
+  for (int i = 0; i < 4; ++i) m.corners[i] = ToPointMsg(marking.corners_map[i]);
+  m.observations = marking.observations;
+  m.first_seen = SafeTime(marking.first_seen);
+  m.last_seen = SafeTime(marking.last_seen);
+  return m;
+}
+
+ipm_road_mapper::LaneSpline ToLaneMsg(const MapLane& lane) {
+  ipm_road_mapper::LaneSpline l;
+  l.id = lane.id;
+  l.class_id = lane.class_id;
+  l.class_name = lane.class_name;
+  l.style = lane.style.empty() ? "unknown" : lane.style;
+  l.control_points.reserve(lane.control_points_map.size());
+  for (const Eigen::Vector3d& c : lane.control_points_map)
+    l.control_points.push_back(ToPointMsg(c));
+  l.observations = lane.observations;
+  l.first_seen = SafeTime(lane.first_seen);
+  l.last_seen = SafeTime(lane.last_seen);
+  return l;
+}
+
 ipm_road_mapper::VectorMapMsg ToVectorMapMsg(const VectorMap& map, const std::string& frame_id,
                                              const ros::Time& stamp) {
   ipm_road_mapper::VectorMapMsg msg;
   msg.header.frame_id = frame_id;
   msg.header.stamp = stamp;
   msg.markings.reserve(map.markings.size());
-  for (const MapMarking& marking : map.markings) {
-    ipm_road_mapper::MarkingPolygon m;
-    m.id = marking.id;
-    m.class_id = marking.class_id;
-    m.class_name = marking.class_name;
-    for (int i = 0; i < 4; ++i) m.corners[i] = ToPointMsg(marking.corners_map[i]);
-    m.observations = marking.observations;
-    m.first_seen = SafeTime(marking.first_seen);
-    m.last_seen = SafeTime(marking.last_seen);
-    msg.markings.push_back(m);
-  }
+  for (const MapMarking& marking : map.markings) msg.markings.push_back(ToMarkingMsg(marking));
   msg.lanes.reserve(map.lanes.size());
-  for (const MapLane& lane : map.lanes) {
-    ipm_road_mapper::LaneSpline l;
-    l.id = lane.id;
-    l.class_id = lane.class_id;
-    l.class_name = lane.class_name;
-    l.style = lane.style.empty() ? "unknown" : lane.style;
-    for (const Eigen::Vector3d& c : lane.control_points_map)
-      l.control_points.push_back(ToPointMsg(c));
-    l.observations = lane.observations;
-    l.first_seen = SafeTime(lane.first_seen);
-    l.last_seen = SafeTime(lane.last_seen);
-    msg.lanes.push_back(l);
-  }
+  for (const MapLane& lane : map.lanes) msg.lanes.push_back(ToLaneMsg(lane));
   msg.base_to_camera = IsometryToTransform(map.T_base_cam);
   for (int i = 0; i < 36; ++i)
     msg.base_to_camera_covariance[i] = map.T_base_cam_covariance(i / 6, i % 6);

@@ -22,8 +22,11 @@
 // $IRM_SOURCE_DIR, else in the install space next to the executable
 // (../../share/ipm_road_mapper). A damaged bag maps what can be read: a message of an
 // unreadable chunk is skipped and counted, and the lost time spans are printed and written to
-// the summary and map.json; a bag without its index (cut short, or never closed) cannot be
-// opened by rosbag's C++ API: one line suggests `rosbag reindex <bag>`, exit 2. Exit status: 0 done
+// the summary and map.json; a bag without its index (cut short, or never closed), which
+// rosbag's C++ API cannot open, is read in record order past the missing index into a
+// temporary indexed copy in <dir> (SalvageUnindexedBag; removed at exit), one line says so,
+// and the copy is mapped; only when that fails too does one line suggest `rosbag reindex
+// <bag>`, exit 2. Exit status: 0 done
 // (or --help); 2 bad input (bad command line, missing bag, bad config, missing topic, no extrinsic,
 // ...) with one error line on stderr; 1 an output could not be written.
 #include <ros/package.h>
@@ -58,6 +61,7 @@
 #include "ipm_road_mapper/ros/bag_input.h"
 #include "ipm_road_mapper/ros/bag_mapping.h"
 #include "ipm_road_mapper/ros/bag_read_loss.h"
+#include "ipm_road_mapper/ros/unindexed_bag.h"
 
 namespace ipm_road_mapper {
 namespace {
@@ -151,10 +155,27 @@ struct RunStats {
   double wall_s = 0.0;
   std::optional<double> startup_s;  // process start to the first frame mapped
   std::string extrinsic_source;
-  std::string camera_frame;  // the masks' frame (empty when the config gave the extrinsic)
-  BagReadLoss lost;          // what could not be read (corrupt chunks)
-  double bag_begin_s = 0.0;  // the bag's first record time; lost spans are relative to it
+  std::string camera_frame;           // the masks' frame (empty when the config gave the extrinsic)
+  BagReadLoss lost;                   // what could not be read (corrupt chunks)
+  double bag_begin_s = 0.0;           // the bag's first record time; lost spans are relative to it
+  std::string index_problem;          // why the bag had to be read past its index ("" = not)
+  std::optional<BagSalvage> salvage;  // what reading it in record order gave
 };
+
+// The summary line about the bag's index: "ok", or how the bag was read past a missing one.
+std::string IndexLine(const RunStats& stats) {
+  if (!stats.salvage) return "index: ok";
+  const BagSalvage& s = *stats.salvage;
+  std::ostringstream line;
+  line.setf(std::ios::fixed);
+  line.precision(2);
+  line << "index: missing (" << stats.index_problem << "): read in record order, " << s.messages
+       << " messages in " << s.chunks << " chunks (" << s.bad_chunks
+       << " chunks did not decompress), record times " << s.first_stamp - stats.bag_begin_s
+       << " to " << s.last_stamp - stats.bag_begin_s << " s; " << s.end
+       << "; whatever was recorded after that is lost";
+  return line.str();
+}
 
 // One line about the optimizer: windows, solve time, how far the extrinsic moved.
 std::string BackendLine(const Mapper& mapper) {
@@ -246,6 +267,7 @@ std::string Summary(const Arguments& args, const Mapper& mapper, const FrameAsse
     << FrontEndLine(mapper) << "\n"
     << "startup_s: " << StartupText(stats.startup_s)
     << " (process start to the first frame mapped)\n"
+    << IndexLine(stats) << "\n"
     << "lost: " << stats.lost.messages << " messages (" << stats.lost.masks << " masks) in "
     << stats.lost.spans.size()
     << " unreadable spans: " << FormatLostSpans(stats.lost, stats.bag_begin_s)
@@ -287,9 +309,20 @@ int Run(int argc, char** argv) {
     throw InputError(e.what());
   }
   if (!fs::is_regular_file(args.bag)) throw InputError(args.bag + ": no such bag file");
-  rosbag::Bag bag;
-  if (const std::string error = OpenBagForReading(args.bag, &bag); !error.empty()) {
+  RunStats stats;
+  OpenedBag opened;  // the bag, or the indexed copy of one without its index
+  if (const std::string error = opened.Open(args.bag, args.out); !error.empty()) {
     throw InputError(error);
+  }
+  rosbag::Bag& bag = opened.bag();
+  if (opened.salvage()) {
+    const BagSalvage& salvage = *opened.salvage();
+    stats.index_problem = opened.index_problem();
+    stats.salvage = salvage;
+    std::cerr << "map_from_bag: " << args.bag << ": " << opened.index_problem()
+              << ": read past the missing index in record order (" << salvage.messages
+              << " messages in " << salvage.chunks << " chunks; " << salvage.end
+              << "); mapping what it holds\n";
   }
   const InputOptions& input = options.input;
   const RosOptions& topics = config.ros;  // the bag's topic names and sync, as the nodelet's
@@ -298,7 +331,6 @@ int Run(int argc, char** argv) {
                            {topics.camera_info_topic, "sensor_msgs/CameraInfo"},
                            {topics.odom_topic, "nav_msgs/Odometry"}});
   if (!topic_error.empty()) throw InputError(args.bag + ": " + topic_error);
-  RunStats stats;
   const Eigen::Isometry3d T_base_cam =
       FindExtrinsic(&bag, input, topics.mask_topic, &stats.extrinsic_source, &stats.camera_frame);
   std::error_code dir_error;
@@ -350,6 +382,8 @@ int Run(int argc, char** argv) {
   map.metadata["startup_s"] = stats.startup_s ? nlohmann::json(*stats.startup_s) : nullptr;
   // Messages of unreadable chunks and the spans of the bag they covered (docs/map_from_bag.md).
   map.metadata["lost"] = LostSpansToJson(stats.lost, stats.bag_begin_s);
+  // A bag read past a missing index: what reading it in record order gave.
+  if (stats.salvage) map.metadata["index"] = IndexLine(stats).substr(7);
   map.geo_origin = config.geo_origin;   // recorded in map.json; the GeoJSON needs it
   map.frame_id = config.ros.map_frame;  // the live nodelet's frame for the same config
   const std::string summary = Summary(args, mapper, session.assembler(), map, stats);

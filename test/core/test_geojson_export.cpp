@@ -171,6 +171,27 @@ TEST(GeoJsonExportTest, WithOriginPositionsAreLonLatAltNearTheOrigin) {
   EXPECT_EQ(j["features"][1]["properties"]["control_points"][1], json::array({0.0, 0.0, 0.0}));
 }
 
+TEST(GeoJsonExportTest, TheHeadingTurnsTheMapFrameIntoEastNorthUp) {
+  // A lane along the map's x axis; the map frame's x points north (heading 90 deg).
+  VectorMap map;
+  MapLane lane;
+  lane.id = 2;
+  for (int i = -1; i <= 2; ++i) lane.control_points_map.emplace_back(100.0 * i, 0.0, 0.0);
+  map.lanes.push_back(lane);
+  GeoOrigin origin = Munich();
+  origin.heading_deg = 90.0;
+  const json j = VectorMapToGeoJson(map, origin);
+  EXPECT_DOUBLE_EQ(j["geo_origin"]["heading_deg"].get<double>(), 90.0);
+  const json& line = j["features"][0]["geometry"]["coordinates"];
+  EXPECT_NEAR(line.back()[0].get<double>(), 11.0, 1e-9);                        // no move east
+  EXPECT_NEAR(line.back()[1].get<double>() - 48.0, 100.0 / 111200.0, 0.00001);  // 100 m north
+  // Heading 0: the map frame is ENU, x east.
+  origin.heading_deg = 0.0;
+  const json enu = VectorMapToGeoJson(map, origin)["features"][0]["geometry"]["coordinates"];
+  EXPECT_NEAR(enu.back()[1].get<double>(), 48.0, 1e-6);
+  EXPECT_GT(enu.back()[0].get<double>(), 11.001);
+}
+
 // Geodesic length (m, on the WGS84 ellipsoid) of a LineString's [lon, lat, alt] positions.
 double GeodesicLength_m(const json& line) {
   const GeographicLib::Geodesic& wgs84 = GeographicLib::Geodesic::WGS84();
@@ -259,6 +280,13 @@ TEST(GeoJsonExportTest, LoadGeoOriginRejectsBadSections) {
   EXPECT_EQ(error_of("{latitude_deg: 48.0}"), "geo_origin.longitude_deg: required key is missing");
   EXPECT_EQ(error_of("{latitude_deg: 91, longitude_deg: 0}"),
             "geo_origin.latitude_deg: must be in [-90, 90]");
+  EXPECT_EQ(error_of("{latitude_deg: 48.0, longitude_deg: 11.0, heading_deg: 400}"),
+            "geo_origin.heading_deg: must be in [-360, 360]");
+  EXPECT_DOUBLE_EQ(LoadGeoOrigin(OptionsReader(Yaml("{latitude_deg: 48.0, longitude_deg: 11.0, "
+                                                    "heading_deg: -12.5}"),
+                                               "geo_origin"))
+                       ->heading_deg,
+                   -12.5);
   EXPECT_EQ(error_of("{latitude_deg: 0, longitude_deg: -181}"),
             "geo_origin.longitude_deg: must be in [-180, 180]");
   EXPECT_EQ(error_of("{latitude_deg: 0, longitude_deg: 0, lat: 3}"), "geo_origin.lat: unknown key");

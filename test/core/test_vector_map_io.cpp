@@ -232,16 +232,22 @@ TEST_F(MapIoTest, GeoOriginRoundTripAndValidation) {
   VectorMap map = MakeMap();
   EXPECT_FALSE(VectorMapToJson(map).contains("geo_origin"));
   EXPECT_FALSE(VectorMapFromJson(VectorMapToJson(map)).geo_origin);
-  map.geo_origin = GeoOrigin{48.137154, 11.576124, 519.25};
+  map.geo_origin = GeoOrigin{48.137154, 11.576124, 519.25, -37.5};
   SaveVectorMapJson(map, Path("geo.json"));
   const VectorMap loaded = LoadVectorMapJson(Path("geo.json"));
   ASSERT_TRUE(loaded.geo_origin);
   EXPECT_EQ(loaded.geo_origin->latitude_deg, 48.137154);
   EXPECT_EQ(loaded.geo_origin->longitude_deg, 11.576124);
   EXPECT_EQ(loaded.geo_origin->altitude_m, 519.25);
+  EXPECT_EQ(loaded.geo_origin->heading_deg, -37.5);  // the heading is recorded too
   nlohmann::json no_altitude = VectorMapToJson(map);
   no_altitude["geo_origin"].erase("altitude_m");
+  no_altitude["geo_origin"].erase("heading_deg");  // a map from before the heading: ENU
   EXPECT_EQ(VectorMapFromJson(no_altitude).geo_origin->altitude_m, 0.0);
+  EXPECT_EQ(VectorMapFromJson(no_altitude).geo_origin->heading_deg, 0.0);
+  nlohmann::json bad_heading = VectorMapToJson(map);
+  bad_heading["geo_origin"]["heading_deg"] = 400.0;
+  EXPECT_THROW(VectorMapFromJson(bad_heading), MapFormatError);
 
   const std::string path = Path("bad_geo.json");
   auto mutated = [&](auto&& mutate) {

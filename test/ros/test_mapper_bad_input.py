@@ -1,5 +1,7 @@
 #!/usr/bin/python3
-"""rostest (b): bad input is skipped, counted and leaves the map (see mapper_bad_input.test).
+"""rostest (b): bad input is skipped, counted and leaves the map (see mapper_bad_input.test);
+and masks that arrive png-compressed (ros/mask_transport: compressed) are mapped as the raw
+ones are.
 
 The drive is test/tools/make_test_bag.py's (2.5 s straight at 8 m/s, an arrow at x 18..21
 and one at 32..35, a lane line at y 1.675), published live with stamps of a synthetic clock.
@@ -10,11 +12,14 @@ import sys
 import time
 import unittest
 
+import io
+
 import numpy as np
 import rospy
 import rostest
 from nav_msgs.msg import Odometry
-from sensor_msgs.msg import CameraInfo, Image
+from PIL import Image as PilImage
+from sensor_msgs.msg import CameraInfo, CompressedImage, Image
 from std_srvs.srv import Trigger
 
 sys.path.insert(0, os.path.dirname(os.path.abspath(__file__)))
@@ -181,6 +186,63 @@ class BadInputTest(unittest.TestCase):
         remapped = self.drive_and_map(200.0)
         self.assertGreaterEqual(len(remapped.markings), 1)
         self.assertEqual(len(self.centers(remapped)), len(self.centers(self.good_map)))
+
+
+    def test_png_compressed_masks_are_mapped(self):
+        """A second instance reads the same drive's masks as 16-bit png CompressedImages on
+        <mask_topic>/compressed (as image_transport's compressed transport sends them) and
+        maps the same markings as the raw instance did."""
+        params = irm.load_config(**{
+            "input/extrinsic": {"xyz": [1.0, 0.0, 1.5], "rpy_deg": [-95.0, 0.0, -90.0]},
+            "ros/mask_transport": "compressed", "ros/mask_topic": "/png/instances",
+            "ros/camera_info_topic": "/png/camera_info", "ros/odom_topic": "/png/odom",
+            "ros/vector_map_full_period_s": 1.0})
+        manager = irm.Manager("/manager")
+        self.assertTrue(manager.load("/mapper_png", params), "cannot load /mapper_png")
+        maps = []
+        rospy.Subscriber("/mapper_png/vector_map", VectorMap, maps.append, queue_size=10)
+        odom_pub = rospy.Publisher("/png/odom", Odometry, queue_size=100)
+        info_pub = rospy.Publisher("/png/camera_info", CameraInfo, queue_size=20)
+        mask_pub = rospy.Publisher("/png/instances/compressed", CompressedImage, queue_size=20)
+        for pub in (odom_pub, info_pub, mask_pub):
+            irm.wait_for(lambda: pub.get_num_connections() > 0, 30, "a subscriber on " + pub.name)
+        steps = int(round(2.6 / drive.ODOM_PERIOD))
+        sent = 0
+        for i in range(steps + 1):
+            t = i * drive.ODOM_PERIOD
+            stamp = rospy.Time.from_sec(T0 + 500.0 + t)
+            odom = Odometry()
+            odom.header.stamp = stamp
+            odom.header.frame_id = "odom"
+            odom.child_frame_id = "base_link"
+            odom.pose.pose.position.x = drive.SPEED * t
+            odom.pose.pose.orientation.w = 1.0
+            odom_pub.publish(odom)
+            if i % 5 == 0 and t > 0:
+                raw = self.render(drive.SPEED * t).astype(np.uint16)
+                png = io.BytesIO()
+                PilImage.fromarray(raw).save(png, format="PNG")
+                mask = CompressedImage()
+                mask.header.stamp = stamp
+                mask.header.frame_id = "camera_optical"
+                mask.format = "16UC1; png compressed "
+                mask.data = png.getvalue()
+                info_pub.publish(camera_info(stamp))
+                mask_pub.publish(mask)
+                sent += 1
+            time.sleep(0.01)
+        irm.wait_for(lambda: self.diagnostics.number("mapper_png: frames", "frames used") >= sent,
+                     30, "every png mask used (%s)" % self.diagnostics.keys("mapper_png: frames"))
+        irm.wait_for(lambda: maps and len(maps[-1].markings) >= len(self.good_map.markings), 30,
+                     "the png instance's map")
+        png_centers, raw_centers = self.centers(maps[-1]), self.centers(self.good_map)
+        self.assertEqual(len(png_centers), len(raw_centers), (png_centers, raw_centers))
+        for (ca, xa, ya), (cb, xb, yb) in zip(png_centers, raw_centers):
+            self.assertEqual(ca, cb)
+            self.assertLess(math.hypot(xa - xb, ya - yb), 0.3)
+        self.assertEqual(self.diagnostics.number("mapper_png: frames",
+                                                 "skipped: bad_mask_encoding"), 0)
+        self.assertTrue(manager.unload("/mapper_png"))
 
 
 if __name__ == "__main__":

@@ -25,7 +25,7 @@ from visualization_msgs.msg import Marker, MarkerArray
 
 sys.path.insert(0, os.path.dirname(os.path.abspath(__file__)))
 import irm_rostest as irm  # noqa: E402
-from ipm_road_mapper.msg import VectorMap  # noqa: E402
+from ipm_road_mapper.msg import VectorMap, VectorMapDelta  # noqa: E402
 from ipm_road_mapper.srv import SaveMap  # noqa: E402
 
 FRAMES = 160  # 8 s at 20 Hz: the first arrows pass under the car
@@ -69,6 +69,33 @@ class Collector:
                             ("/mapper/debug_image", Image)):
             rospy.Subscriber(topic, kind, self._store, callback_args=topic, queue_size=20)
         rospy.Subscriber("/tf_static", TFMessage, self._on_tf, queue_size=20)
+        # A client of ~vector_map_delta alone: every delta from the first, applied in order.
+        self.delta_sequences, self.delta_markings, self.delta_lanes = [], {}, {}
+        self.delta_stamp = rospy.Time(0)
+        rospy.Subscriber("/mapper/vector_map_delta", VectorMapDelta, self._on_delta,
+                         queue_size=10000)
+
+    def _on_delta(self, msg):
+        with self.lock:
+            self.delta_sequences.append(msg.sequence)
+            self.delta_stamp = msg.header.stamp
+            if msg.reset:
+                self.delta_markings.clear()
+                self.delta_lanes.clear()
+            for i in msg.removed_marking_ids:
+                self.delta_markings.pop(i, None)
+            for i in msg.removed_lane_ids:
+                self.delta_lanes.pop(i, None)
+            for m in msg.markings:
+                self.delta_markings[m.id] = [(c.x, c.y, c.z) for c in m.corners]
+            for patch in msg.lanes:
+                points = self.delta_lanes.get(patch.id, [])[:patch.first_index]
+                self.delta_lanes[patch.id] = points + [(c.x, c.y, c.z)
+                                                       for c in patch.control_points]
+
+    def latest_delta_stamp(self):
+        with self.lock:
+            return self.delta_stamp
 
     def _store(self, msg, topic):
         with self.lock:
@@ -127,6 +154,13 @@ class MapperBagTest(unittest.TestCase):
         irm.wait_for(lambda: len(cls.topics.latest.get("/mapper/corrected_path", Path()).poses)
                      >= cls.diagnostics.number("mapper: frames", "frames used"), 30,
                      "the corrected path to hold every used frame")
+        # ... and the full ~vector_map (ros/vector_map_full_period_s: 1 s here) follows the
+        # last delta.
+        irm.wait_for(lambda: cls.topics.latest.get("/mapper/vector_map") is not None and
+                     cls.topics.delta_sequences and
+                     cls.topics.latest["/mapper/vector_map"].header.stamp >=
+                     cls.topics.latest_delta_stamp(), 30, "the full map after the last delta")
+        time.sleep(2.5)  # a change without a new frame (a late solve) is sent in full too
 
         save = rospy.ServiceProxy("/mapper/save_map", SaveMap)
         cls.save_response = save(path=cls.out + "/live_service/map.json")
@@ -167,6 +201,25 @@ class MapperBagTest(unittest.TestCase):
         self.assertGreaterEqual(len(vector_map.lanes), 2)
         for lane in vector_map.lanes:
             self.assertGreaterEqual(len(lane.control_points), 4)
+
+    def test_vector_map_delta_rebuilds_the_full_map(self):
+        """Every delta from the first, applied in order, gives the last full ~vector_map."""
+        vector_map = self.topics.latest.get("/mapper/vector_map")
+        self.assertIsNotNone(vector_map, "no ~vector_map")
+        with self.topics.lock:
+            sequences = list(self.topics.delta_sequences)
+            markings = dict(self.topics.delta_markings)
+            lanes = dict(self.topics.delta_lanes)
+        self.assertGreater(len(sequences), 3, "too few ~vector_map_delta messages")
+        self.assertEqual(sequences, list(range(1, len(sequences) + 1)), "a delta was lost")
+        full_markings = {m.id: [(c.x, c.y, c.z) for c in m.corners] for m in vector_map.markings}
+        full_lanes = {l.id: [(c.x, c.y, c.z) for c in l.control_points] for l in vector_map.lanes}
+        self.assertEqual(set(markings), set(full_markings))
+        self.assertEqual(set(lanes), set(full_lanes))
+        for i, corners in full_markings.items():
+            self.assertEqual(markings[i], corners, "marking %d" % i)
+        for i, points in full_lanes.items():
+            self.assertEqual(lanes[i], points, "lane %d" % i)
 
     def test_refined_extrinsic_tf(self):
         with self.topics.lock:

@@ -140,6 +140,35 @@ TEST(MapperDiagnostics, ExtrinsicChangeAndSolveTimes) {
   DiagnosticStatusWrapper w;
   FillOptimizerStatus(later, now, &w);
   EXPECT_EQ(w.level, DiagnosticStatus::WARN);
+  // Windows dropped because the optimizer's queue was full: it falls behind.
+  MapperStatusSnapshot behind = later;
+  behind.backend.dropped_queue_full = now.backend.dropped_queue_full + 3;
+  DiagnosticStatusWrapper b;
+  FillOptimizerStatus(behind, later, &b);
+  EXPECT_EQ(b.level, DiagnosticStatus::WARN);
+  EXPECT_NE(b.message.find("falls behind: 3 window(s) dropped"), std::string::npos) << b.message;
+  DiagnosticStatusWrapper steady;
+  FillOptimizerStatus(behind, behind, &steady);  // none dropped during this period
+  EXPECT_EQ(steady.level, DiagnosticStatus::OK);
+}
+
+TEST(MapperDiagnostics, LostInputsAreReportedWithTheQueueDepths) {
+  MapperStatusSnapshot before;
+  before.mask_queue_size = 10;
+  before.odom_queue_size = 200;
+  MapperStatusSnapshot now = before;
+  now.mask_gaps.lost_by_stamp = 9;
+  now.odometry_gaps.lost_by_seq = 2;
+  DiagnosticStatusWrapper s;
+  FillFrameStatus(now, before, InputStats(), &s);
+  EXPECT_EQ(Value(s, "subscriber queue: masks"), "10");
+  EXPECT_EQ(Value(s, "subscriber queue: odometry"), "200");
+  EXPECT_EQ(Value(s, "masks lost before the callback (stamp gaps)"), "9");
+  EXPECT_EQ(Value(s, "odometry lost before the callback (seq gaps)"), "2");
+  EXPECT_EQ(s.level, DiagnosticStatus::WARN);
+  DiagnosticStatusWrapper quiet;
+  FillFrameStatus(now, now, InputStats(), &quiet);  // nothing new lost
+  EXPECT_NE(quiet.message.find("idle"), std::string::npos) << quiet.message;
 }
 
 TEST(MapperDiagnostics, SavesShowTheLastSaveAndAFailureIsAnError) {

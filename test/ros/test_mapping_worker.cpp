@@ -173,6 +173,33 @@ TEST(MappingWorker, FinishReturnsTheFinishedMapAndStopJoins) {
   worker.Stop();  // idempotent
 }
 
+TEST(MappingWorker, SnapshotsShareTheFrozenTrajectoryAndSavesGetItWhole) {
+  MapperConfig config = Config(100000);
+  config.ros.path_max_poses = 10;
+  config.mapper.backend.window_frames = 20;  // a solve may change the newest 200 frames
+  MappingWorker worker(config, Classes(), "test", kNoTf, {});
+  constexpr int kFrames = 1500;
+  Feed(&worker, kFrames);
+  ASSERT_TRUE(WaitForSnapshot(worker, [](const MapSnapshot& s) {
+    return s.map && s.status.counters.frames_used == kFrames;
+  }));
+  const auto snapshot = worker.Latest();
+  // 1300 frames are out of every window: one 1000-pose chunk frozen, the rest in the map.
+  ASSERT_EQ(snapshot->trajectory_prefix.size(), 1u);
+  EXPECT_EQ(snapshot->map->trajectory.size(), kFrames - 1000u);
+  const auto full = snapshot->FullMap();
+  ASSERT_EQ(full->trajectory.size(), static_cast<std::size_t>(kFrames));
+  for (std::size_t i = 0; i < full->trajectory.size(); ++i) {
+    ASSERT_NEAR(full->trajectory[i].stamp, 0.1 * static_cast<double>(i) + 0.05, 1e-9) << i;
+  }
+  // The finished map (the shutdown save) has every pose as well.
+  bool finished = false;
+  const auto finished_map = worker.Finish(Clock::now() + std::chrono::seconds(5), &finished);
+  EXPECT_TRUE(finished);
+  ASSERT_NE(finished_map, nullptr);
+  EXPECT_EQ(finished_map->trajectory.size(), static_cast<std::size_t>(kFrames));
+}
+
 TEST(MappingWorker, FinishBeforeAnyFrameHasNoMap) {
   MappingWorker worker(Config(), Classes(), "test", kNoTf, {});
   bool finished = false;

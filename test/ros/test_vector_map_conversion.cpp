@@ -186,7 +186,7 @@ TEST(MarkerBuilder, ChangesModeSendsOnlyWhatChanged) {
   ASSERT_EQ(changes.markers.size(), 4u);
   for (const Marker& m : changes.markers) {
     EXPECT_EQ(m.action, Marker::ADD);
-    EXPECT_EQ(m.id, m.ns.rfind("mark", 0) == 0 ? 11 : 5) << m.ns;
+    EXPECT_EQ(m.id, m.ns.rfind("mark", 0) == 0 ? 11 : LaneChunkMarkerId(5, 0)) << m.ns;
   }
   // A lane's class changes (re-colored), the other lane leaves the map.
   map.lanes[1].class_id = 7;
@@ -196,7 +196,9 @@ TEST(MarkerBuilder, ChangesModeSendsOnlyWhatChanged) {
             (std::set<std::string>{"lanes", "lane_control_points"}));
   EXPECT_EQ(NamespacesOf(after, Marker::ADD),
             (std::set<std::string>{"lanes", "lane_control_points"}));
-  for (const Marker& m : after.markers) EXPECT_EQ(m.id, m.action == Marker::DELETE ? 4 : 5);
+  for (const Marker& m : after.markers) {
+    EXPECT_EQ(m.id, LaneChunkMarkerId(m.action == Marker::DELETE ? 4 : 5, 0));
+  }
   // kFull re-sends every element, with no DELETE for what is still there.
   const auto full = builder.Build(map, "odom", ros::Time(5.0), Mode::kFull);
   EXPECT_EQ(full.markers.size(), 4u);

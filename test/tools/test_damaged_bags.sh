@@ -1,9 +1,11 @@
 #!/usr/bin/env bash
 # map_from_bag on damaged bags (test/tools/damage_bag.py damages the small drive of
 # test/tools/make_test_bag.py, 25 masks in lz4 chunks, one mask per chunk):
-#  - cut at 90 % (no index): one line suggesting `rosbag reindex`, exit 2; the reindexed bag
-#    maps >= 80 % of the frames;
-#  - never closed (index position 0): the same suggestion, exit 2;
+#  - cut at 90 % (no index): mapped without reindexing (its chunks read in record order), one
+#    stderr line and the summary say so, >= 80 % of the frames and as many as the reindexed
+#    bag; cut after its first records (nothing readable): one line suggesting `rosbag
+#    reindex`, exit 2;
+#  - never closed (index position 0): mapped the same way, every frame;
 #  - two corrupt chunks (bytes flipped in their lz4 data): exit 0, the frames of the other
 #    chunks mapped, the lost spans (those of the chunks) on stderr, in summary.txt and in
 #    map.json metadata;
@@ -52,21 +54,50 @@ frames() { sed -n "s/^frames $1: \([0-9]*\)$/\1/p" "$2"; }
 
 /usr/bin/python3 "$repo/test/tools/make_test_bag.py" "$work/drive.bag"
 
-# 1. Cut at 90 %: refused with the suggestion; reindexed, it maps.
-damage truncate "$work/drive.bag" "$work/cut.bag" --fraction 0.9
-expect_reindex_line "$work/cut.bag" "truncated"
-rosbag reindex "$work/cut.bag" >/dev/null 2>&1 || fail "rosbag reindex cut.bag"
-run_mapper "$work/cut.bag" "$work/cut_reindexed"
-used=$(frames used "$work/cut_reindexed/summary.txt" 2>/dev/null || true)
-if [ "$rc" -eq 0 ] && [ -n "$used" ] && [ "$used" -ge 20 ]; then
-  pass "reindexed cut bag: exit 0, $used of 25 frames used (>= 80 %)"
-else
-  fail "reindexed cut bag: exit $rc, frames used '${used}': $(tail -3 "$work/cut_reindexed.stderr")"
-fi
+# Expects $1 (a bag without its index) mapped in record order: exit 0, one stderr line
+# saying so, >= $3 frames used, the summary's index line naming $2.
+expect_salvaged() {
+  local bag="$1" why="$2" min_used="$3" name
+  name="$(basename "$bag" .bag)"
+  run_mapper "$bag" "$work/$name"
+  local err="$work/$name.stderr" summary="$work/$name/summary.txt"
+  used=$(frames used "$summary" 2>/dev/null || true)
+  if [ "$rc" -ne 0 ]; then
+    fail "$name: exit $rc, expected 0: $(tail -3 "$err")"
+  elif ! grep -q "^map_from_bag: $bag: .*$why.*: read past the missing index in record order" "$err"; then
+    fail "$name: no 'read past the missing index' line naming '$why' on stderr:"; cat "$err"
+  elif [ -z "$used" ] || [ "$used" -lt "$min_used" ]; then
+    fail "$name: frames used '${used}', expected >= $min_used"
+  elif ! grep -q "^index: missing (.*$why" "$summary"; then
+    fail "$name: no 'index: missing' line in summary.txt"
+  elif ls -A "$work/$name" | grep -q "indexed.bag"; then
+    fail "$name: the temporary indexed copy was left in the output folder"
+  else
+    pass "$name -> exit 0 without reindexing, $used of 25 frames used: $(grep '^index:' "$summary")"
+  fi
+}
 
-# 2. A recording that was never closed (index position 0).
+# 1. Cut at 90 %: mapped without `rosbag reindex` (its chunks read in order), as many frames
+#    as the reindexed bag gives.
+damage truncate "$work/drive.bag" "$work/cut.bag" --fraction 0.9
+expect_salvaged "$work/cut.bag" "truncated" 20
+salvaged_used="$used"
+cp "$work/cut.bag" "$work/cut_copy.bag"
+rosbag reindex "$work/cut_copy.bag" >/dev/null 2>&1 || fail "rosbag reindex cut_copy.bag"
+run_mapper "$work/cut_copy.bag" "$work/cut_reindexed"
+used=$(frames used "$work/cut_reindexed/summary.txt" 2>/dev/null || true)
+if [ "$rc" -eq 0 ] && [ -n "$used" ] && [ "$salvaged_used" -ge "$used" ]; then
+  pass "reindexed cut bag: $used frames used, record order: $salvaged_used"
+else
+  fail "reindexed cut bag: exit $rc, frames used '${used}', record order '${salvaged_used}'"
+fi
+# Cut right after its first records: nothing readable, one line suggesting reindex, exit 2.
+damage truncate "$work/drive.bag" "$work/stub.bag" --fraction 0.002
+expect_reindex_line "$work/stub.bag" "truncated"
+
+# 2. A recording that was never closed (index position 0): every chunk read in order.
 damage unclose "$work/drive.bag" "$work/open.bag"
-expect_reindex_line "$work/open.bag" "no index"
+expect_salvaged "$work/open.bag" "no index" 23
 
 # 3. Two corrupt chunks (mask chunks 8 and 16: stamps 0.93 s and 1.73 s after the start).
 damage corrupt "$work/drive.bag" "$work/corrupt.bag" --chunks 8 16 >"$work/corrupted_chunks.txt"

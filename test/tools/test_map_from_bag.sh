@@ -169,7 +169,8 @@ if run_mapper --bag "$work/drive.bag" --config "$geo_config" --out "$work/geo" >
   /usr/bin/python3 -c '
 import json, sys
 o = json.load(open(sys.argv[1]))["geo_origin"]
-assert o == {"latitude_deg": 48.0, "longitude_deg": 11.0, "altitude_m": 500.0}, o' \
+assert o == {"latitude_deg": 48.0, "longitude_deg": 11.0, "altitude_m": 500.0,
+            "heading_deg": 0.0}, o  # the heading is recorded too (0: the map frame is ENU)' \
     "$work/geo/map.json" && pass "map.json records the geo_origin" || fail "geo_origin in map.json"
   # A copy of that folder mapped again without an origin: the stale GeoJSON goes.
   cp -r "$work/geo" "$work/stale"

@@ -19,11 +19,14 @@ namespace ipm_road_mapper {
 // config/ros.yaml (a test checks that they agree).
 struct RosOptions {
   std::string mask_topic = "/camera/instances";  // sensor_msgs/Image, 16UC1 masks
+  // How masks arrive: "raw" (sensor_msgs/Image), "compressed" (png on <mask_topic>/compressed)
+  // or another installed image_transport plugin's name.
+  std::string mask_transport = "raw";
   std::string camera_info_topic = "/camera/camera_info";
   std::string image_topic = "/camera/image_raw";  // optional ("" = none), debug overlay only
   std::string odom_topic = "/odom";               // nav_msgs/Odometry
   std::string sync = "exact";                     // exact | approximate (mask <-> camera_info)
-  double publish_rate_hz = 2.0;  // ~vector_map, ~markers, ~corrected_path, refined tf
+  double publish_rate_hz = 2.0;  // ~vector_map_delta, ~markers, ~corrected_path, refined tf
   // REP-105 frames, named as robot_localization names them: the map and everything
   // corrected is in map_frame (also map.json's frame_id, offline and live); the odometry is
   // in odom_frame; with publish_map_to_odom the nodelet broadcasts map_frame -> odom_frame
@@ -51,6 +54,9 @@ struct RosOptions {
   // ~markers: the full marker set is re-sent this often (and to every new subscriber);
   // in between only what changed.
   double marker_full_period_s = 10.0;
+  // ~vector_map (the whole map) is published this often; ~vector_map_delta carries the
+  // changes at publish_rate_hz in between.
+  double vector_map_full_period_s = 10.0;
   // Unload / shutdown with save_map_path: the time the last solve may take before the
   // latest snapshot is saved instead.
   double shutdown_budget_s = 3.0;

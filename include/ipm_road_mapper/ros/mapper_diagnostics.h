@@ -1,7 +1,9 @@
 // The nodelet's diagnostics (diagnostic_updater, on /diagnostics): four statuses,
 //   "<node>: inputs"    rates of masks, camera_info, synchronized pairs, odometry, images;
 //   "<node>: frames"    frames received / used / skipped by reason, masks dropped by the
-//                       sync (no camera_info), odometry counters, callback time;
+//                       sync (no camera_info), masks and odometry lost before their
+//                       callbacks (subscriber queue full: seq / stamp gaps), odometry
+//                       counters, callback and publication cost;
 //   "<node>: optimizer" windows submitted / solved / dropped / unusable, solve time;
 //   "<node>: extrinsic" where the rough extrinsic came from, and how far the refined one
 //                       moved from it;
@@ -26,6 +28,7 @@
 #include "ipm_road_mapper/core/backend/backend.h"
 #include "ipm_road_mapper/core/mapper/mapper.h"
 #include "ipm_road_mapper/pipeline/frame_assembler.h"
+#include "ipm_road_mapper/ros/input_gap_counter.h"
 
 namespace ipm_road_mapper {
 
@@ -69,6 +72,13 @@ struct MapperStatusSnapshot {
   std::array<std::uint64_t, 3> inputs_dropped{};  // input queue full: frames, odometry, images
   std::uint64_t publishes = 0;                    // map publications (timer cycles that sent)
   double publish_cpu_last_ms = 0.0, publish_cpu_mean_ms = 0.0, publish_cpu_max_ms = 0.0;
+  std::size_t publish_last_markers = 0;         // the last publication's ~markers entries
+  std::size_t publish_last_delta_elements = 0;  // ... ~vector_map_delta elements and ids
+  std::size_t publish_last_bytes = 0;           // ... serialized bytes of all its messages
+  // Subscriber queues (ros/sync_queue_size, ros/odom_queue_size) and the messages that never
+  // reached the callbacks, told by header seq / stamp gaps (InputGapCounter).
+  int mask_queue_size = 0, odom_queue_size = 0;
+  InputGapStats mask_gaps, odometry_gaps;
   MapSaveStatus save;
 };
 

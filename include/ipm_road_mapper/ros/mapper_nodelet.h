@@ -53,6 +53,7 @@
 #include "ipm_road_mapper/ros/map_saver.h"
 #include "ipm_road_mapper/ros/mapper_diagnostics.h"
 #include "ipm_road_mapper/ros/mapping_worker.h"
+#include "ipm_road_mapper/ros/mask_input.h"
 #include "ipm_road_mapper/ros/pose_publisher.h"
 
 namespace ipm_road_mapper {
@@ -111,7 +112,9 @@ class MapperNodelet : public nodelet::Nodelet {
   double frame_callback_total_ms_ = 0.0, frame_callback_max_ms_ = 0.0;
   std::uint64_t publishes_ = 0;
   double publish_cpu_last_ms_ = 0.0, publish_cpu_total_ms_ = 0.0, publish_cpu_max_ms_ = 0.0;
-  std::uint64_t published_version_ = 0;  // output thread only
+  PublishCounts publish_last_;
+  InputGapCounter mask_gaps_, odometry_gaps_;  // written by the data callbacks
+  std::uint64_t published_version_ = 0;        // output thread only
 
   // Declared before every handle that uses it, so it is destroyed after them.
   ros::CallbackQueue output_queue_;
@@ -120,7 +123,7 @@ class MapperNodelet : public nodelet::Nodelet {
   std::unique_ptr<tf2_ros::TransformListener> tf_listener_;
   // Subscribers before the synchronizers: the synchronizers disconnect from them when
   // destroyed, so they must go first (members are destroyed in reverse order).
-  message_filters::Subscriber<sensor_msgs::Image> mask_sub_;
+  std::unique_ptr<MaskInput> mask_sub_;  // ros/mask_transport
   message_filters::Subscriber<sensor_msgs::CameraInfo> info_sub_;
   std::unique_ptr<message_filters::Synchronizer<ExactPolicy>> exact_sync_;
   std::unique_ptr<message_filters::Synchronizer<ApproximatePolicy>> approximate_sync_;

@@ -23,6 +23,7 @@
 #include "ipm_road_mapper/core/map/vector_map.h"
 #include "ipm_road_mapper/pipeline/bounded_input_queue.h"
 #include "ipm_road_mapper/pipeline/extrinsic_source.h"
+#include "ipm_road_mapper/pipeline/frozen_trajectory.h"
 #include "ipm_road_mapper/pipeline/mapper_config.h"
 #include "ipm_road_mapper/pipeline/mapping_session.h"
 #include "ipm_road_mapper/ros/mapper_diagnostics.h"
@@ -30,15 +31,22 @@
 
 namespace ipm_road_mapper {
 
-// What the timers and services read; immutable once swapped in.
+// What the timers and services read; immutable once swapped in. Its cost does not grow with
+// the drive: `map` holds only the newest poses of the trajectory (those a solve may still
+// correct, at least ros/path_max_poses), the older ones are the frozen chunks that every
+// snapshot shares; FullMap() joins them for a save.
 struct MapSnapshot {
   std::shared_ptr<const VectorMap> map;  // with the nodelet's metadata; nullptr before start
+  TrajectoryChunks trajectory_prefix;    // the poses before map->trajectory
   std::uint64_t map_version = 0;         // changes whenever the map may have changed
   std::uint64_t resets = 0;              // ~resets before this map (its generation)
   double newest_frame_stamp = 0.0;       // of the newest used frame (s)
   std::string map_frame = "map";
   std::string refined_camera_frame;  // tf child of the refined extrinsic ("" before start)
   MapperStatusSnapshot status;       // the session's counters for the diagnostics
+
+  // The map with its whole trajectory (a copy: what a save writes); nullptr without a map.
+  std::shared_ptr<const VectorMap> FullMap() const;
 };
 
 // What the mapping thread hands the nodelet after a frame was used.
@@ -89,7 +97,7 @@ class MappingWorker {
   // End of input: no more pushes; the thread maps what is queued, runs
   // MappingSession::Finish with the time left until `deadline` and exports the map. Waits
   // until then or `deadline`; returns the finished map (*finished = true) or else the
-  // latest snapshot's map; nullptr when the session never started.
+  // latest snapshot's map (FullMap); nullptr when the session never started.
   std::shared_ptr<const VectorMap> Finish(Clock::time_point deadline, bool* finished);
 
   // Stops and joins the mapping thread (idempotent); queued inputs are discarded.
@@ -107,7 +115,9 @@ class MappingWorker {
   // Runs the pending ~reset; true when the thread is to end (stop or finish done).
   bool RunCommands();
   void RunFinish(Clock::time_point deadline);
-  std::shared_ptr<VectorMap> ExportMap() const;
+  // The map with the trajectory after the frozen prefix (freezing more of what no window
+  // solve changes any more), or with the whole trajectory exported afresh.
+  std::shared_ptr<VectorMap> ExportMap(bool whole_trajectory);
   MapperStatusSnapshot Status() const;
 
   const MapperConfig config_;
@@ -126,6 +136,8 @@ class MappingWorker {
   bool status_dirty_ = true;
   double newest_frame_stamp_ = 0.0;
   std::shared_ptr<const VectorMap> exported_map_;
+  FrozenTrajectory frozen_trajectory_;  // the poses no solve changes any more
+  TrajectoryChunks exported_prefix_;    // frozen_trajectory_'s chunks as of exported_map_
   Clock::time_point next_export_, last_overlay_;
 
   BoundedInputQueue<MapperInputItem> queue_;

@@ -1,14 +1,18 @@
 // The map as rviz markers (visualization_msgs/MarkerArray):
-// - namespace "lanes": each lane spline sampled every 0.5 m as a LINE_STRIP;
-// - "lane_control_points": its control points (phantom ends included) as a SPHERE_LIST;
+// - namespace "lanes": each lane spline sampled every 0.5 m, as one LINE_STRIP per chunk of
+//   `lane_chunk_segments` spline segments (consecutive chunks share their end sample);
+// - "lane_control_points": the chunk's control points (phantom ends included) as a
+//   SPHERE_LIST with the chunk's id;
 // - "markings": each marking's 4 corners as a closed LINE_STRIP;
 // - "marking_labels": its class name as TEXT_VIEW_FACING above its center.
 // Colors by class (ClassColor). The builder remembers what it published, with a fingerprint
 // of each element's class and geometry: an element that left the map (a merged lane, a
 // dropped spurious marking, a reset) gets a DELETE, so rviz never shows stale markers, and
 // in kChanges mode an element whose fingerprint did not change is not built nor sent again
-// (the per-publish cost then follows what changed, not the map's length). Marker ids are
-// the element ids (mod 2^31), stable over the element's life.
+// (the per-publish cost then follows what changed, not the map's length): a lane that grows
+// at its end re-sends its last chunk or two, not the whole lane. Marking marker ids are
+// the element ids (mod 2^31); lane chunk ids are LaneChunkMarkerId; both stable over the
+// element's life.
 #pragma once
 
 #include <ros/time.h>
@@ -16,10 +20,12 @@
 #include <visualization_msgs/MarkerArray.h>
 
 #include <cstddef>
-#include <map>
+#include <cstdint>
 #include <set>
 #include <string>
+#include <unordered_map>
 #include <utility>
+#include <vector>
 
 #include "ipm_road_mapper/core/map/vector_map.h"
 
@@ -29,11 +35,27 @@ namespace ipm_road_mapper {
 // white; every other class gets a color of a 12-color palette picked by its id.
 std_msgs::ColorRGBA ClassColor(int class_id, const std::string& class_name);
 
+// The marker id of chunk `chunk` of lane `lane_id`: the lane id's low 21 bits, then the
+// chunk's low 10 bits (unique for lanes of up to 1024 chunks, ids below 2^21).
+int LaneChunkMarkerId(std::uint64_t lane_id, std::size_t chunk);
+
+// One chunk of a lane's markers, as control-point index ranges.
+struct LaneChunk {
+  std::size_t index = 0;                          // 0 = the chunk at the lane's start
+  std::size_t curve_first = 0, curve_last = 0;    // [first, last): the points its curve uses
+  std::size_t points_first = 0, points_last = 0;  // [first, last): the points it draws
+};
+
+// How a lane of `control_points` points is cut into chunks of `chunk_segments` segments
+// (the last may be shorter; one chunk of every point when there is no spline, < 4 points).
+std::vector<LaneChunk> LaneChunks(std::size_t control_points, std::size_t chunk_segments);
+
 // Builds MarkerArrays of successive maps, with DELETEs for what disappeared.
 class MarkerBuilder {
  public:
-  // Lane samples every `lane_sample_spacing_m` of arc length.
-  explicit MarkerBuilder(double lane_sample_spacing_m = 0.5);
+  // Lane samples every `lane_sample_spacing_m` of arc length; lane markers in chunks of
+  // `lane_chunk_segments` spline segments.
+  explicit MarkerBuilder(double lane_sample_spacing_m = 0.5, std::size_t lane_chunk_segments = 16);
 
   // kFull: every element's markers; kChanges: only those of elements that are new or whose
   // class or geometry changed since they were last sent.
@@ -48,10 +70,16 @@ class MarkerBuilder {
   visualization_msgs::MarkerArray Clear();
 
  private:
-  using MarkerKey = std::pair<std::string, int>;  // (namespace, id)
+  // What was sent of one marker: its element's fingerprint, and the last Build that drew it.
+  struct Sent {
+    std::size_t fingerprint = 0;
+    std::uint64_t generation = 0;
+  };
   double lane_sample_spacing_m_;
-  // Every marker on screen now, with the fingerprint of the element it draws.
-  std::map<MarkerKey, std::size_t> published_;
+  std::size_t lane_chunk_segments_;
+  // Every marker on screen now, by (namespace index << 32 | id).
+  std::unordered_map<std::uint64_t, Sent> published_;
+  std::uint64_t generation_ = 0;  // Build calls so far
 };
 
 }  // namespace ipm_road_mapper

@@ -14,6 +14,10 @@
 
 namespace ipm_road_mapper {
 
+// One marking / lane as its message (element stamps in seconds -> ros::Time).
+ipm_road_mapper::MarkingPolygon ToMarkingMsg(const MapMarking& marking);
+ipm_road_mapper::LaneSpline ToLaneMsg(const MapLane& lane);
+
 // VectorMap -> message in `frame_id` at `stamp`: markings (4 corners), lanes (control points,
 // phantom ends included), the refined extrinsic. Element stamps in seconds -> ros::Time.
 ipm_road_mapper::VectorMapMsg ToVectorMapMsg(const VectorMap& map, const std::string& frame_id,

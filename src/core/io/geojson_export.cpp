@@ -31,15 +31,20 @@ class PositionConverter {
   explicit PositionConverter(const std::optional<GeoOrigin>& origin) {
     if (origin) {
       local_cartesian_.emplace(origin->latitude_deg, origin->longitude_deg, origin->altitude_m);
+      const double heading = origin->heading_deg * M_PI / 180.0;
+      cos_heading_ = std::cos(heading);
+      sin_heading_ = std::sin(heading);
     }
   }
 
-  // [lon, lat, alt] with an origin (x = east, y = north, z = up), else [x, y, z].
+  // [lon, lat, alt] with an origin (the map point turned by the heading into east, north,
+  // up), else [x, y, z].
   nlohmann::json Position(const Eigen::Vector3d& p_map) const {
     if (!local_cartesian_) return Rounded(p_map, kMetricScale);
+    const double east = cos_heading_ * p_map.x() - sin_heading_ * p_map.y();
+    const double north = sin_heading_ * p_map.x() + cos_heading_ * p_map.y();
     double latitude_deg = 0.0, longitude_deg = 0.0, altitude_m = 0.0;
-    local_cartesian_->Reverse(p_map.x(), p_map.y(), p_map.z(), latitude_deg, longitude_deg,
-                              altitude_m);
+    local_cartesian_->Reverse(east, north, p_map.z(), latitude_deg, longitude_deg, altitude_m);
     return nlohmann::json::array({Round(longitude_deg, kDegreeScale),
                                   Round(latitude_deg, kDegreeScale),
                                   Round(altitude_m, kMetricScale)});
@@ -51,6 +56,7 @@ class PositionConverter {
 
  private:
   std::optional<GeographicLib::LocalCartesian> local_cartesian_;
+  double cos_heading_ = 1.0, sin_heading_ = 0.0;
 };
 
 // Twice the signed area of the polygon's x-y projection (> 0: counter-clockwise from above).
@@ -143,7 +149,8 @@ nlohmann::json VectorMapToGeoJson(const VectorMap& map, const std::optional<GeoO
   if (origin) {
     collection["geo_origin"] = {{"latitude_deg", origin->latitude_deg},
                                 {"longitude_deg", origin->longitude_deg},
-                                {"altitude_m", origin->altitude_m}};
+                                {"altitude_m", origin->altitude_m},
+                                {"heading_deg", origin->heading_deg}};
   }
   collection["features"] = std::move(features);
   return collection;
@@ -155,8 +162,8 @@ void SaveGeoJson(const VectorMap& map, const std::optional<GeoOrigin>& origin,
 }
 
 std::optional<GeoOrigin> LoadGeoOrigin(OptionsReader reader) {
-  const bool any_key =
-      reader.Has("latitude_deg") || reader.Has("longitude_deg") || reader.Has("altitude_m");
+  const bool any_key = reader.Has("latitude_deg") || reader.Has("longitude_deg") ||
+                       reader.Has("altitude_m") || reader.Has("heading_deg");
   auto in_range = [](double limit) {
     return [limit](const double& v) -> std::string {
       return std::isfinite(v) && std::abs(v) <= limit
@@ -173,6 +180,7 @@ std::optional<GeoOrigin> LoadGeoOrigin(OptionsReader reader) {
   reader.Read<double>("altitude_m", &origin.altitude_m, [](const double& v) -> std::string {
     return std::isfinite(v) ? "" : "must be finite";
   });
+  reader.Read<double>("heading_deg", &origin.heading_deg, in_range(360.0));
   reader.RejectUnknownKeys();
   if (!any_key) return std::nullopt;
   return origin;

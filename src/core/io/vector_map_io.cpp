@@ -104,7 +104,8 @@ namespace {
 nlohmann::json GeoOriginToJson(const GeoOrigin& origin) {
   return {{"latitude_deg", origin.latitude_deg},
           {"longitude_deg", origin.longitude_deg},
-          {"altitude_m", origin.altitude_m}};
+          {"altitude_m", origin.altitude_m},
+          {"heading_deg", origin.heading_deg}};
 }
 
 // A number within [-limit, limit] (ReadNumber checks that it is finite).
@@ -123,6 +124,8 @@ GeoOrigin GeoOriginFromJson(const nlohmann::json& j, const std::string& where) {
   origin.latitude_deg = ReadBounded(j, "latitude_deg", 90.0, where);
   origin.longitude_deg = ReadBounded(j, "longitude_deg", 180.0, where);
   origin.altitude_m = json_io::OptionalNumber(j, "altitude_m", 0.0, where);
+  origin.heading_deg =
+      j.contains("heading_deg") ? ReadBounded(j, "heading_deg", 360.0, where) : 0.0;
   return origin;
 }
 

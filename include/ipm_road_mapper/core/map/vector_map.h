@@ -48,12 +48,14 @@ struct MapLane {
   double last_seen = 0.0;
 };
 
-// Where the map frame's origin is on the Earth (config section `geo_origin`); the map frame
-// is taken to be ENU (x east, y north, z up) there.
+// Where the map frame's origin is on the Earth (config section `geo_origin`), and how it is
+// turned there: the map frame's x axis points `heading_deg` counter-clockwise from east
+// (z up), so 0 means the map frame is ENU (x east, y north, z up).
 struct GeoOrigin {
   double latitude_deg = 0.0;   // WGS84, north positive, [-90, 90]
   double longitude_deg = 0.0;  // WGS84, east positive, [-180, 180]
   double altitude_m = 0.0;     // height above the WGS84 ellipsoid
+  double heading_deg = 0.0;    // map x axis from east, counter-clockwise, [-360, 360]
 };
 
 // The whole exported map.

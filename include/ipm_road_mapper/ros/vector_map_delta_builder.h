@@ -1,0 +1,64 @@
+// Builds ~vector_map_delta messages (msg/VectorMapDelta.msg): the markings of a map that are
+// new or changed since the previous delta, the changed end of each new or changed lane
+// (LaneSplinePatch), and the ids of the elements that left the map. It remembers a
+// fingerprint per marking and per chunk of each lane's control points, so a message
+// carries what changed, not the whole map: retired markings, which no solve moves any
+// more, are sent once; a lane that grows sends its last chunk or two.
+#pragma once
+
+#include <ros/time.h>
+
+#include <cstddef>
+#include <cstdint>
+#include <string>
+#include <unordered_map>
+#include <vector>
+
+#include "ipm_road_mapper/VectorMapDelta.h"
+#include "ipm_road_mapper/core/map/vector_map.h"
+
+namespace ipm_road_mapper {
+
+class VectorMapDeltaBuilder {
+ public:
+  // Lane control points are compared in chunks of `lane_chunk_points` (> 0).
+  explicit VectorMapDeltaBuilder(std::size_t lane_chunk_points = 16);
+
+  // The delta from the previous call's map to `map`, in `frame_id` at `stamp` (the first
+  // call: every element).
+  ipm_road_mapper::VectorMapDelta Build(const VectorMap& map, const std::string& frame_id,
+                                        const ros::Time& stamp);
+
+  // A delta with `reset` set and nothing else (after ~reset); forgets every element.
+  ipm_road_mapper::VectorMapDelta Clear(const std::string& frame_id, const ros::Time& stamp);
+
+ private:
+  // What was sent of one marking, and the last Build whose map held it.
+  struct MarkingSent {
+    std::size_t fingerprint = 0;  // MessageFingerprint
+    std::uint64_t generation = 0;
+  };
+  // What was sent of one lane, and the last Build whose map held it.
+  struct LaneSent {
+    std::size_t fields = 0;           // MessageFingerprint without the control points
+    std::vector<std::size_t> chunks;  // fingerprint per chunk of control points
+    std::size_t points = 0;
+    std::uint64_t generation = 0;
+  };
+  // Fills *sent with what `lane`'s patch would depend on (generation untouched).
+  void Describe(const MapLane& lane, LaneSent* sent) const;
+  ipm_road_mapper::VectorMapDelta NewDelta(const std::string& frame_id, const ros::Time& stamp);
+
+  std::size_t lane_chunk_points_;
+  std::uint32_t sequence_ = 0;
+  std::uint64_t generation_ = 0;  // Build calls so far
+  std::unordered_map<std::uint64_t, MarkingSent> markings_;
+  std::unordered_map<std::uint64_t, LaneSent> lanes_;
+};
+
+// Applies `delta` to `map` (a client's copy, started from a ~vector_map): what a subscriber
+// of both topics does. Lane patches whose first_index is past the lane's points are applied
+// at its end.
+void ApplyVectorMapDelta(const ipm_road_mapper::VectorMapDelta& delta, VectorMap* map);
+
+}  // namespace ipm_road_mapper

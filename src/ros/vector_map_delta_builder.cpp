@@ -1,0 +1,178 @@
+#include "ipm_road_mapper/ros/vector_map_delta_builder.h"
+
+#include <algorithm>
+#include <functional>
+#include <unordered_set>
+#include <utility>
+
+#include "ipm_road_mapper/ros/element_fingerprint.h"
+#include "ipm_road_mapper/ros/msg_conversion.h"
+#include "ipm_road_mapper/ros/vector_map_conversion.h"
+
+namespace ipm_road_mapper {
+namespace {
+
+// Erases the entries `generation` did not see and returns their ids, sorted (the elements
+// that left the map).
+template <typename Sent>
+std::vector<std::uint64_t> EraseUnseen(std::unordered_map<std::uint64_t, Sent>* sent,
+                                       std::uint64_t generation) {
+  std::vector<std::uint64_t> gone;
+  for (auto it = sent->begin(); it != sent->end();) {
+    if (it->second.generation == generation) {
+      ++it;
+      continue;
+    }
+    gone.push_back(it->first);
+    it = sent->erase(it);
+  }
+  std::sort(gone.begin(), gone.end());
+  return gone;
+}
+
+// A patch of `lane` carrying its control points from `first` on.
+ipm_road_mapper::LaneSplinePatch Patch(const MapLane& lane, std::size_t first) {
+  const ipm_road_mapper::LaneSpline whole = ToLaneMsg(lane);
+  ipm_road_mapper::LaneSplinePatch patch;
+  patch.id = whole.id;
+  patch.class_id = whole.class_id;
+  patch.class_name = whole.class_name;
+  patch.style = whole.style;
+  patch.first_index = static_cast<std::uint32_t>(first);
+  patch.control_points.assign(whole.control_points.begin() + first, whole.control_points.end());
+  patch.observations = whole.observations;
+  patch.first_seen = whole.first_seen;
+  patch.last_seen = whole.last_seen;
+  return patch;
+}
+
+}  // namespace
+
+VectorMapDeltaBuilder::VectorMapDeltaBuilder(std::size_t lane_chunk_points)
+    : lane_chunk_points_(std::max<std::size_t>(lane_chunk_points, 1)) {}
+
+void VectorMapDeltaBuilder::Describe(const MapLane& lane, LaneSent* sent) const {
+  sent->fields = FieldsFingerprint(lane);
+  sent->points = lane.control_points_map.size();
+  sent->chunks.clear();
+  for (std::size_t first = 0; first < sent->points; first += lane_chunk_points_) {
+    sent->chunks.push_back(GeometryFingerprint(lane, first, first + lane_chunk_points_));
+  }
+}
+
+ipm_road_mapper::VectorMapDelta VectorMapDeltaBuilder::NewDelta(const std::string& frame_id,
+                                                                const ros::Time& stamp) {
+  ipm_road_mapper::VectorMapDelta delta;
+  delta.header.frame_id = frame_id;
+  delta.header.stamp = stamp;
+  delta.sequence = ++sequence_;
+  delta.base_to_camera.rotation.w = 1.0;
+  return delta;
+}
+
+ipm_road_mapper::VectorMapDelta VectorMapDeltaBuilder::Build(const VectorMap& map,
+                                                             const std::string& frame_id,
+                                                             const ros::Time& stamp) {
+  ipm_road_mapper::VectorMapDelta delta = NewDelta(frame_id, stamp);
+  ++generation_;
+  for (const MapMarking& marking : map.markings) {
+    const std::size_t fingerprint = MessageFingerprint(marking);
+    const auto [it, added] = markings_.try_emplace(marking.id);
+    if (added || it->second.fingerprint != fingerprint) {
+      delta.markings.push_back(ToMarkingMsg(marking));
+    }
+    it->second = {fingerprint, generation_};
+  }
+  LaneSent now;
+  for (const MapLane& lane : map.lanes) {
+    Describe(lane, &now);
+    now.generation = generation_;
+    const auto [it, added] = lanes_.try_emplace(lane.id);
+    if (added) {
+      delta.lanes.push_back(Patch(lane, 0));
+    } else {
+      // The first chunk that differs: the points before it are as sent.
+      const LaneSent& before = it->second;
+      std::size_t chunk = 0;
+      while (chunk < now.chunks.size() && chunk < before.chunks.size() &&
+             now.chunks[chunk] == before.chunks[chunk]) {
+        ++chunk;
+      }
+      const std::size_t first = std::min(chunk * lane_chunk_points_, now.points);
+      const bool points_changed = first < now.points || now.points != before.points;
+      if (points_changed || now.fields != before.fields) delta.lanes.push_back(Patch(lane, first));
+    }
+    std::swap(it->second, now);  // `now` keeps the old chunk vector's memory for the next lane
+  }
+  delta.removed_marking_ids = EraseUnseen(&markings_, generation_);
+  delta.removed_lane_ids = EraseUnseen(&lanes_, generation_);
+  delta.base_to_camera = IsometryToTransform(map.T_base_cam);
+  return delta;
+}
+
+ipm_road_mapper::VectorMapDelta VectorMapDeltaBuilder::Clear(const std::string& frame_id,
+                                                             const ros::Time& stamp) {
+  ipm_road_mapper::VectorMapDelta delta = NewDelta(frame_id, stamp);
+  delta.reset = true;
+  markings_.clear();
+  lanes_.clear();
+  return delta;
+}
+
+void ApplyVectorMapDelta(const ipm_road_mapper::VectorMapDelta& delta, VectorMap* map) {
+  if (delta.reset) {
+    map->markings.clear();
+    map->lanes.clear();
+  }
+  map->frame_id = delta.header.frame_id;
+  const std::unordered_set<std::uint64_t> gone_markings(delta.removed_marking_ids.begin(),
+                                                        delta.removed_marking_ids.end());
+  const std::unordered_set<std::uint64_t> gone_lanes(delta.removed_lane_ids.begin(),
+                                                     delta.removed_lane_ids.end());
+  auto& markings = map->markings;
+  markings.erase(std::remove_if(markings.begin(), markings.end(),
+                                [&](const MapMarking& m) { return gone_markings.count(m.id); }),
+                 markings.end());
+  auto& lanes = map->lanes;
+  lanes.erase(std::remove_if(lanes.begin(), lanes.end(),
+                             [&](const MapLane& l) { return gone_lanes.count(l.id); }),
+              lanes.end());
+  std::unordered_map<std::uint64_t, std::size_t> marking_at, lane_at;
+  for (std::size_t i = 0; i < markings.size(); ++i) marking_at[markings[i].id] = i;
+  for (std::size_t i = 0; i < lanes.size(); ++i) lane_at[lanes[i].id] = i;
+  for (const auto& m : delta.markings) {
+    ipm_road_mapper::VectorMapMsg one;
+    one.markings.push_back(m);
+    const MapMarking marking = FromVectorMapMsg(one).markings.front();
+    const auto it = marking_at.find(m.id);
+    if (it == marking_at.end()) {
+      marking_at[m.id] = markings.size();
+      markings.push_back(marking);
+    } else {
+      markings[it->second] = marking;
+    }
+  }
+  for (const auto& patch : delta.lanes) {
+    auto it = lane_at.find(patch.id);
+    if (it == lane_at.end()) {
+      it = lane_at.emplace(patch.id, lanes.size()).first;
+      lanes.emplace_back();
+      lanes.back().id = patch.id;
+    }
+    MapLane& lane = lanes[it->second];
+    lane.class_id = patch.class_id;
+    lane.class_name = patch.class_name;
+    lane.style = patch.style == "unknown" ? "" : patch.style;
+    const std::size_t keep =
+        std::min<std::size_t>(patch.first_index, lane.control_points_map.size());
+    lane.control_points_map.resize(keep);
+    for (const auto& p : patch.control_points) lane.control_points_map.push_back(FromPointMsg(p));
+    lane.observations = patch.observations;
+    lane.first_seen = ToSeconds(patch.first_seen);
+    lane.last_seen = ToSeconds(patch.last_seen);
+  }
+  Eigen::Isometry3d T = Eigen::Isometry3d::Identity();
+  if (TransformToIsometry(delta.base_to_camera, &T).empty()) map->T_base_cam = T;
+}
+
+}  // namespace ipm_road_mapper
