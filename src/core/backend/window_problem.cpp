@@ -10,6 +10,7 @@
 
 #include "ipm_road_mapper/core/backend/residuals/along_lane_anchor_residual.h"
 #include "ipm_road_mapper/core/backend/residuals/corner_reprojection_residual.h"
+#include "ipm_road_mapper/core/backend/residuals/edge_reprojection_residual.h"
 #include "ipm_road_mapper/core/backend/residuals/extrinsic_prior_residual.h"
 #include "ipm_road_mapper/core/backend/residuals/lane_smoothness_residual.h"
 #include "ipm_road_mapper/core/backend/residuals/motion_prior_residual.h"
@@ -53,6 +54,15 @@ struct CornerMeasurement {
   Eigen::Vector2d uv;
 };
 
+// One pixel on a measured side of a partial view whose corner the view cut (the edge
+// residual): which marking, side (corners side and side + 1) and frame slot.
+struct EdgeMeasurement {
+  std::size_t marking = 0;
+  int side = 0;
+  std::size_t slot = 0;
+  Eigen::Vector2d uv;
+};
+
 // One lane pixel: which lane, frame slot and spline segment (the segment's control points
 // are c[segment] .. c[segment + 3]; PPSR uses c[segment + 1], c[segment + 2]).
 struct LanePixel {
@@ -73,6 +83,7 @@ struct WindowState {
   std::vector<std::array<Eigen::Vector3d, 4>> corners;
   std::vector<std::vector<Eigen::Vector3d>> control_points;
   std::vector<CornerMeasurement> corner_measurements;
+  std::vector<EdgeMeasurement> edge_measurements;
   std::vector<LanePixel> lane_pixels;
   std::vector<Eigen::Isometry3d> poses;  // the frames' poses at the start (road surface)
   double step_time_limit_s = std::numeric_limits<double>::infinity();  // of the next step
@@ -115,15 +126,24 @@ void CollectCornerMeasurements(const WindowSnapshot& snapshot, const BackendOpti
         RoadSurfaceNear(state->poses, center, options.road_plane_radius_m).plane;
     const Eigen::Vector3d& axis = snapshot.markings[m].axis_map;
     const auto& measurements = snapshot.markings[m].measurements;
+    // Partial views measure a marking no whole view shows (one larger than the view); where
+    // whole views exist they alone are measurements (see docs/backend.md, "Partial views").
+    const bool seen_whole =
+        std::any_of(measurements.begin(), measurements.end(),
+                    [](const MarkingMeasurement& meas) { return meas.Complete(); });
+    std::vector<std::size_t> usable;
+    for (std::size_t i = 0; i < measurements.size(); ++i) {
+      if (!seen_whole || measurements[i].Complete()) usable.push_back(i);
+    }
     // At most max_measurements_per_marking of them, spread over the history (the first and
     // the last included): neighbouring frames see a marking almost alike.
     const std::size_t cap = static_cast<std::size_t>(options.max_measurements_per_marking);
     std::vector<std::size_t> chosen;
-    if (measurements.size() <= cap) {
-      for (std::size_t i = 0; i < measurements.size(); ++i) chosen.push_back(i);
+    if (usable.size() <= cap) {
+      chosen = usable;
     } else {
       for (std::size_t k = 0; k < cap; ++k) {
-        chosen.push_back(k * (measurements.size() - 1) / (cap - 1));
+        chosen.push_back(usable[k * (usable.size() - 1) / (cap - 1)]);
       }
     }
     for (std::size_t i : chosen) {
@@ -140,10 +160,19 @@ void CollectCornerMeasurements(const WindowSnapshot& snapshot, const BackendOpti
         }
       }
       for (int c = 0; c < 4; ++c) {
+        // A cut corner is no measurement (partial views): its sides may still be.
+        if (!meas.CornerMeasured(c) || !corners_uv[c].allFinite()) continue;
         if (!ProjectsNearImage(camera, *state, slot->second, corners[c],
                                options.max_outside_image_px))
           continue;
         state->corner_measurements.push_back({m, c, slot->second, corners_uv[c]});
+      }
+      for (int side = 0; side < 4; ++side) {
+        if (!meas.side_measured[side]) continue;
+        if (meas.CornerMeasured(side) && meas.CornerMeasured((side + 1) % 4)) continue;
+        for (const Eigen::Vector2d& uv : meas.side_uv[side]) {
+          state->edge_measurements.push_back({m, side, slot->second, uv});
+        }
       }
     }
   }
@@ -263,6 +292,15 @@ ceres::Solver::Summary MapStep(const WindowSnapshot& snapshot, const BackendOpti
                                loss, corner.data(), q_bc, t_bc);
       ++*blocks;
     }
+    for (const EdgeMeasurement& m : state->edge_measurements) {
+      const PoseBlocks& pose = state->frames[m.slot];
+      auto& corners = state->corners[m.marking];
+      problem.AddResidualBlock(residuals::EdgeReprojectionMapStepResidual::Create(
+                                   camera, m.uv, options.pixel_sigma_px, pose.q, pose.t),
+                               loss, corners[m.side].data(), corners[(m.side + 1) % 4].data(), q_bc,
+                               t_bc);
+      ++*blocks;
+    }
   }
   for (const LanePixel& px : state->lane_pixels) {
     auto& cps = state->control_points[px.lane];
@@ -286,9 +324,24 @@ ceres::Solver::Summary MapStep(const WindowSnapshot& snapshot, const BackendOpti
   }
   // Map points: on the road surface (softly), z optionally held; control points anchored
   // along their lane (PPSR leaves that direction free: a gauge of each point).
-  for (auto& corners : state->corners) {
-    for (auto& c : corners) {
+  // A corner that only edge residuals reach slides along its side at no cost: held loosely
+  // where it is (isotropic lane_anchor_across_sigma_m, as a lane's control point across its
+  // lane), the edges decide across the side.
+  std::vector<std::array<bool, 4>> has_corner_pixel(state->corners.size(),
+                                                    {{false, false, false, false}});
+  for (const CornerMeasurement& m : state->corner_measurements) {
+    has_corner_pixel[m.marking][m.corner] = true;
+  }
+  for (std::size_t k = 0; k < state->corners.size(); ++k) {
+    for (int i = 0; i < 4; ++i) {
+      auto& c = state->corners[k][i];
       if (!problem.HasParameterBlock(c.data())) continue;
+      if (!has_corner_pixel[k][i]) {
+        problem.AddResidualBlock(residuals::AlongLaneAnchorResidual::Create(
+                                     c, Eigen::Vector3d::Zero(), options.lane_anchor_along_sigma_m,
+                                     options.lane_anchor_across_sigma_m),
+                                 nullptr, c.data());
+      }
       if (options.optimize_z) AddRoadSurfacePrior(options, *state, c.data(), &problem);
       ConfigurePoint(options, c.data(), &problem);
     }
@@ -351,6 +404,16 @@ ceres::Solver::Summary PoseStep(const WindowSnapshot& snapshot, const BackendOpt
         residuals::CornerReprojectionPoseStepResidual::Create(
             camera, m.uv, options.pixel_sigma_px, state->corners[m.marking][m.corner], q_bc, t_bc),
         loss, pose.q, pose.t);
+    ++*blocks;
+  }
+  for (const EdgeMeasurement& m : state->edge_measurements) {
+    if (!snapshot.markings[m.marking].mature || !snapshot.frames[m.slot].in_window) continue;
+    PoseBlocks& pose = state->frames[m.slot];
+    const auto& corners = state->corners[m.marking];
+    problem.AddResidualBlock(residuals::EdgeReprojectionPoseStepResidual::Create(
+                                 camera, m.uv, options.pixel_sigma_px, corners[m.side],
+                                 corners[(m.side + 1) % 4], q_bc, t_bc),
+                             loss, pose.q, pose.t);
     ++*blocks;
   }
   if (options.lane_residual == LaneResidual::kPpsr) {

@@ -141,6 +141,7 @@ VectorMap Mapper::ExportMap(const ExportOptions& export_options) const {
     marking.observations = static_cast<int>(element.Observations());
     marking.first_seen = element.first_seen;
     marking.last_seen = element.last_seen;
+    marking.sides_measured = element.side_measured;
     out.markings.push_back(marking);
   }
   const bool refit = !windows_.LanesRefined();

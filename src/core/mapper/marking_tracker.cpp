@@ -7,29 +7,29 @@
 
 #include "ipm_road_mapper/core/frontend/association.h"
 #include "ipm_road_mapper/core/frontend/instance_extraction.h"
+#include "ipm_road_mapper/core/mapper/marking_extent.h"
 
 namespace ipm_road_mapper {
 namespace {
 
+// The measurement of an observation in its element's corner order: element corner i is the
+// observation's corner (i + shift) % 4, element side i its side (i + shift) % 4.
+MarkingMeasurement MeasurementOf(const MarkingObservation& obs, std::size_t frame_index,
+                                 int shift) {
+  MarkingMeasurement measurement;
+  measurement.frame_index = frame_index;
+  for (int i = 0; i < 4; ++i) {
+    measurement.corners_uv[i] = obs.corners_uv[(i + shift) % 4];
+    measurement.corners_base[i] = obs.corners_base[(i + shift) % 4];
+    measurement.side_measured[i] = obs.side_measured[(i + shift) % 4];
+    measurement.side_uv[i] = obs.side_uv[(i + shift) % 4];
+  }
+  measurement.outline_uv = obs.outline_uv;
+  return measurement;
+}
+
 // Below this angle (rad) from base_link's x axis the extracted rectangle is kept.
 constexpr double kRoadAxisMinAngleRad = 1e-3;
-
-// Area of the intersection of two ground rectangles (x-y), over the smaller one's area.
-double OverlapOfSmaller(const std::array<Eigen::Vector3d, 4>& a,
-                        const std::array<Eigen::Vector3d, 4>& b) {
-  auto polygon = [](const std::array<Eigen::Vector3d, 4>& corners) {
-    std::vector<cv::Point2f> p;
-    for (const Eigen::Vector3d& c : corners) p.emplace_back(c.x(), c.y());
-    if (cv::contourArea(p, true) < 0.0) std::reverse(p.begin(), p.end());  // counterclockwise
-    return p;
-  };
-  const std::vector<cv::Point2f> pa = polygon(a), pb = polygon(b);
-  const double smaller = std::min(cv::contourArea(pa), cv::contourArea(pb));
-  if (!(smaller > 1e-6)) return 0.0;
-  std::vector<cv::Point2f> intersection;
-  const double area = cv::intersectConvexConvex(pa, pb, intersection, true);
-  return std::max(0.0, area) / smaller;
-}
 
 // Largest horizontal distance of a corner from the center.
 double Radius(const MarkingElement& e) {
@@ -79,6 +79,7 @@ MarkingTracker::MarkingTracker(const MapperOptions& options, MapStore* store,
 void MarkingTracker::Update(const Ipm& ipm, const FrameRecord& frame,
                             std::vector<MarkingObservation>* observations) {
   OrientAlongRoad(ipm, frame, observations);
+
   Associate(*observations, frame);
   MergeDuplicates();
 }
@@ -115,6 +116,7 @@ void MarkingTracker::Associate(const std::vector<MarkingObservation>& observatio
     candidate.class_id = obs.class_id;
     for (int i = 0; i < 4; ++i) candidate.corners_map[i] = frame.T_map_base * obs.corners_base[i];
     candidate.center_cov_map = R * obs.center_cov_base * R.transpose();
+    candidate.complete = obs.Complete();
     candidates.push_back(candidate);
   }
   // The live markings and the retired ones within the gate of some candidate (re-observed
@@ -126,8 +128,13 @@ void MarkingTracker::Associate(const std::vector<MarkingObservation>& observatio
   for (const MarkingCandidate& c : candidates) {
     const Eigen::Vector3d center =
         0.25 * (c.corners_map[0] + c.corners_map[1] + c.corners_map[2] + c.corners_map[3]);
-    const double radius =
-        MarkingGateRadius(c, store_->max_retired_cov_trace(), options_.association);
+    double radius = MarkingGateRadius(c, store_->max_retired_cov_trace(), options_.association);
+    // A partial view can lie anywhere on a larger element: search as far as it reaches again.
+    if (!c.complete) {
+      for (const Eigen::Vector3d& corner : c.corners_map) {
+        radius = std::max(radius, 2.0 * (corner - center).head<2>().norm());
+      }
+    }
     for (std::size_t i : store_->RetiredMarkingsNear(center, radius)) retired_near.push_back(i);
   }
   std::sort(retired_near.begin(), retired_near.end());
@@ -153,7 +160,9 @@ void MarkingTracker::Associate(const std::vector<MarkingObservation>& observatio
       element.class_id = obs.class_id;
       element.corners_map = candidates[c].corners_map;
       element.center_cov_map = candidates[c].center_cov_map;
-      element.history.push_back({frame.index, obs.corners_uv, obs.corners_base, obs.outline_uv});
+      element.side_measured = obs.side_measured;
+      for (int s = 0; s < 4; ++s) element.side_views[s] = obs.side_measured[s] ? 1 : 0;
+      element.history.push_back(MeasurementOf(obs, frame.index, 0));
       element.first_frame = element.last_frame = frame.index;
       element.first_seen = element.last_seen = frame.stamp;
       markings.push_back(std::move(element));
@@ -161,27 +170,31 @@ void MarkingTracker::Associate(const std::vector<MarkingObservation>& observatio
       continue;
     }
     MarkingElement& element = markings[match[c]];
-    const int shift = BestCyclicShift(element.corners_map, candidates[c].corners_map, nullptr);
-    MarkingMeasurement measurement;
-    measurement.frame_index = frame.index;
-    for (int i = 0; i < 4; ++i) {
-      measurement.corners_uv[i] = obs.corners_uv[(i + shift) % 4];
-      measurement.corners_base[i] = obs.corners_base[(i + shift) % 4];
-    }
-    measurement.outline_uv = obs.outline_uv;
+    // Whole views pair corners by distance (as always); a partial view by side direction.
+    const bool whole = element.Complete() && candidates[c].complete;
+    const int shift = whole
+                          ? BestCyclicShift(element.corners_map, candidates[c].corners_map, nullptr)
+                          : SideAlignedShift(element.corners_map, candidates[c].corners_map);
+    const MarkingMeasurement measurement = MeasurementOf(obs, frame.index, shift);
     element.history.push_back(measurement);
     element.last_frame = frame.index;
     element.last_seen = frame.stamp;
     if (candidates[c].center_cov_map.trace() < element.center_cov_map.trace()) {
       element.center_cov_map = candidates[c].center_cov_map;
     }
-    if (element.optimized) continue;  // the back end owns the estimate
-    // Plain IPM estimate: the running mean of the observed corners in the map.
-    const double n = static_cast<double>(element.Observations());
-    for (int i = 0; i < 4; ++i) {
-      element.corners_map[i] +=
-          (candidates[c].corners_map[(i + shift) % 4] - element.corners_map[i]) / n;
+    std::array<Eigen::Vector3d, 4> observed_map;
+    for (int i = 0; i < 4; ++i) observed_map[i] = candidates[c].corners_map[(i + shift) % 4];
+    if (whole && !element.optimized) {
+      // Plain IPM estimate: the running mean of the observed corners in the map.
+      const double n = static_cast<double>(element.Observations());
+      for (int i = 0; i < 4; ++i) {
+        element.corners_map[i] += (observed_map[i] - element.corners_map[i]) / n;
+        ++element.side_views[i];
+      }
+      continue;
     }
+    if (whole) continue;  // the back end owns the estimate
+    UpdateExtent(observed_map, measurement.side_measured, element.optimized, &element);
   }
 }
 

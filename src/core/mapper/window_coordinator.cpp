@@ -143,7 +143,11 @@ void WindowCoordinator::RetireMarking(MarkingElement* marking) {
   const RoadSurfaceEstimate road = store_->RoadSurfaceAt(marking->Center());
   const RoadPlane& plane = road.plane;
   const Eigen::Vector3d axis = store_->RoadDirectionAt(marking->Center());
+  // As in the window problem: partial views only for a marking no whole view shows.
+  const bool seen_whole = std::any_of(marking->history.begin(), marking->history.end(),
+                                      [](const MarkingMeasurement& m) { return m.Complete(); });
   for (const MarkingMeasurement& m : marking->history) {
+    if (seen_whole && !m.Complete()) continue;
     const Eigen::Isometry3d& T_map_base = store_->frames()[m.frame_index].T_map_base;
     std::array<Eigen::Vector2d, 4> corners_uv = m.corners_uv;
     if (axis.norm() > 0.0 && !m.outline_uv.empty()) {
@@ -153,7 +157,11 @@ void WindowCoordinator::RetireMarking(MarkingElement* marking) {
         corners_uv = on_plane;
       }
     }
-    for (int c = 0; c < 4; ++c) input.corners.push_back({c, corners_uv[c], T_map_base});
+    for (int c = 0; c < 4; ++c) {
+      // Only corners the view measured (a partial view's cut corners are where it ended).
+      if (!m.CornerMeasured(c) || !corners_uv[c].allFinite()) continue;
+      input.corners.push_back({c, corners_uv[c], T_map_base});
+    }
   }
   if (options_.backend.optimize_z) {
     for (int c = 0; c < 4; ++c) {

@@ -29,6 +29,15 @@ struct MarkingMeasurement {
   // The instance's convex outline in the image: the back end re-measures the corners from
   // it on a better road plane than base_link's (MeasureCornersOnPlane).
   std::vector<Eigen::Vector2d> outline_uv;
+  // Partial views (MarkingObservation): which sides (side i from corner i to i + 1) the view
+  // measured, and the observed boundary pixels of each; a corner is a measurement only where
+  // both of its sides are.
+  std::array<bool, 4> side_measured{{true, true, true, true}};
+  std::array<std::vector<Eigen::Vector2d>, 4> side_uv;
+  bool CornerMeasured(int i) const { return side_measured[(i + 3) % 4] && side_measured[i]; }
+  bool Complete() const {
+    return side_measured[0] && side_measured[1] && side_measured[2] && side_measured[3];
+  }
 };
 
 // A mapped ground marking.
@@ -47,8 +56,17 @@ struct MarkingElement {
   double first_seen = 0.0, last_seen = 0.0;
   bool optimized = false;  // the back end owns the estimate from now on
   bool retired = false;    // left the window: its information is in the extrinsic prior
+  // Per side (side i from corner i to i + 1): some view saw the marking's boundary there.
+  // An unmeasured side is where the views ended so far: the extent grows past it as later
+  // views show more (a marking larger than the view), and the export says so.
+  std::array<bool, 4> side_measured{{true, true, true, true}};
+  // How many views measured each side (the running mean of its position).
+  std::array<std::size_t, 4> side_views{{0, 0, 0, 0}};
   // Every observation ever made, pruned ones included.
   std::size_t Observations() const { return history.size() + pruned; }
+  bool Complete() const {
+    return side_measured[0] && side_measured[1] && side_measured[2] && side_measured[3];
+  }
   Eigen::Vector3d Center() const {
     return 0.25 * (corners_map[0] + corners_map[1] + corners_map[2] + corners_map[3]);
   }
