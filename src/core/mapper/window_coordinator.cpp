@@ -268,6 +268,7 @@ WindowSnapshot WindowCoordinator::BuildSnapshot() {
   for (const MarkingElement& m : store_->markings()) {
     if (m.last_frame < first) continue;  // outside the window: held fixed
     if (!SeenUpClose(m)) continue;       // the front end's estimate until it is
+    if (!m.confirmed) continue;          // tentative (maybe a spurious blob): no pull
     WindowMarking wm{m.id, m.corners_map, m.history, store_->RoadDirectionAt(m.Center()),
                      m.optimized && m.Observations() >= kMinMatureObservations};
     for (const MarkingMeasurement& meas : m.history) {

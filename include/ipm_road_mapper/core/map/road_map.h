@@ -62,6 +62,15 @@ struct MarkingElement {
   std::array<bool, 4> side_measured{{true, true, true, true}};
   // How many views measured each side (the running mean of its position).
   std::array<std::size_t, 4> side_views{{0, 0, 0, 0}};
+  // Consistency with the road's motion (MarkingTracker::CheckConsistency): frames since
+  // creation in which it should have been visible (its center in the image, no farther
+  // than its farthest view) and those of them that saw it. A marking is confirmed once seen
+  // in at least half the frames it was expected in (and twice); until then it is tentative:
+  // not exported, not in the back end. A spurious blob is never seen again where it should.
+  std::size_t frames_expected = 0;
+  std::size_t frames_seen = 0;
+  double farthest_view_m = 0.0;  // largest ground distance of a view's center from base_link
+  bool confirmed = false;
   // Every observation ever made, pruned ones included.
   std::size_t Observations() const { return history.size() + pruned; }
   bool Complete() const {
