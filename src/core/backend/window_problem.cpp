@@ -151,7 +151,9 @@ void CollectCornerMeasurements(const WindowSnapshot& snapshot, const BackendOpti
       const auto slot = state->slot_of_frame.find(meas.frame_index);
       if (slot == state->slot_of_frame.end()) continue;
       std::array<Eigen::Vector2d, 4> corners_uv = meas.corners_uv;
-      if (!meas.outline_uv.empty() && axis.norm() > 0.0) {
+      // Whole views are re-measured on the road plane; a partial view keeps its corners as
+      // labeled (its rectangle on another plane could move a cut side onto a measured one).
+      if (meas.Complete() && !meas.outline_uv.empty() && axis.norm() > 0.0) {
         const Eigen::Isometry3d T_map_cam = state->frames[slot->second].ToIsometry() * T_base_cam;
         std::array<Eigen::Vector2d, 4> on_plane;
         if (MeasureCornersOnPlane(camera, T_map_cam, plane, axis, corners, meas.outline_uv,

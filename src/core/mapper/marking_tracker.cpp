@@ -40,6 +40,21 @@ constexpr std::size_t kMinSeenToConfirm = 3;
 constexpr double kMinSeenFraction = 0.5;
 constexpr std::size_t kMinExpectedToJudge = 4;
 
+// True when some frame observed both elements (their histories share a frame index).
+bool SeenTogether(const MarkingElement& a, const MarkingElement& b) {
+  auto i = a.history.begin();
+  auto j = b.history.begin();
+  while (i != a.history.end() && j != b.history.end()) {
+    if (i->frame_index == j->frame_index) return true;
+    if (i->frame_index < j->frame_index) {
+      ++i;
+    } else {
+      ++j;
+    }
+  }
+  return false;
+}
+
 // Largest horizontal distance of a corner from the center.
 double Radius(const MarkingElement& e) {
   double r = 0.0;
@@ -243,9 +258,17 @@ void MarkingTracker::MergeDuplicates() {
   // close-range view (partly outside the image's useful part) did.
   const AssociationOptions& o = options_.association;
   const double gate2 = o.marking_merge_distance_m * o.marking_merge_distance_m;
+  const double floor2 = std::pow(MarkingFloorSigma(o), 2);
+  const double sigma_gate2 = o.marking_gate_sigmas * o.marking_gate_sigmas;
   auto same_marking = [&](const MarkingElement& x, const MarkingElement& y) {
     const Eigen::Vector2d d = (x.Center() - y.Center()).head<2>();
     if (d.squaredNorm() <= gate2) return true;
+    // Re-observed after a gap, or first seen far (IPM meters off): within the gate of the
+    // combined uncertainty of both elements' best views, and never seen in one frame (two
+    // markings side by side are seen together; one marking's two elements never are).
+    const Eigen::Matrix2d S =
+        x.center_cov_map + y.center_cov_map + floor2 * Eigen::Matrix2d::Identity();
+    if (d.dot(S.ldlt().solve(d)) <= sigma_gate2 && !SeenTogether(x, y)) return true;
     if (o.marking_merge_overlap <= 0.0) return false;
     if (d.norm() > Radius(x) + Radius(y)) return false;  // rectangles that cannot touch
     return OverlapOfSmaller(x.corners_map, y.corners_map) >= o.marking_merge_overlap;
