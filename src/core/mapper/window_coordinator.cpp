@@ -269,6 +269,12 @@ WindowSnapshot WindowCoordinator::BuildSnapshot() {
     if (m.last_frame < first) continue;  // outside the window: held fixed
     if (!SeenUpClose(m)) continue;       // the front end's estimate until it is
     if (!m.confirmed) continue;          // tentative (maybe a spurious blob): no pull
+    // Seen only in partial views (larger than the view): the front end's extent, no pull on
+    // the extrinsic (on av2_pit_dev such crossings pulled the roll by 0.8 deg; open).
+    if (std::none_of(m.history.begin(), m.history.end(),
+                     [](const MarkingMeasurement& meas) { return meas.Complete(); })) {
+      continue;
+    }
     WindowMarking wm{m.id, m.corners_map, m.history, store_->RoadDirectionAt(m.Center()),
                      m.optimized && m.Observations() >= kMinMatureObservations};
     for (const MarkingMeasurement& meas : m.history) {
