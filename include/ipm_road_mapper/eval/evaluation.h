@@ -63,7 +63,7 @@ struct MapMarkingResult {
   Eigen::Vector3d center_error_map = Eigen::Vector3d::Constant(kNoValue);  // map - GT
   double center_error_m = kNoValue;
   double corner_error_m = kNoValue;  // mean corner distance, best cyclic order
-  bool complete = true;  // the map says every side was measured (MapMarking::Complete)
+  bool complete = true;              // the map says every side was measured (MapMarking::Complete)
 };
 
 // Per GT marking: whether the map has it.
@@ -90,8 +90,8 @@ struct MarkingMetrics {
   // a lower-bound rectangle's, so they are counted and their APE reported apart as well.
   int matched_incomplete = 0;
   ErrorSummary center_error_complete_m;  // center APE over matched complete markings only
-  double recall = kNoValue;     // matched_visible / gt_visible
-  double precision = kNoValue;  // matched / map_total
+  double recall = kNoValue;              // matched_visible / gt_visible
+  double precision = kNoValue;           // matched / map_total
   ErrorSummary center_error_m;
   ErrorSummary corner_error_m;
   Eigen::Vector3d mean_abs_error_xyz_m = Eigen::Vector3d::Constant(kNoValue);
