@@ -285,24 +285,42 @@ ceres::Solver::Summary MapStep(const WindowSnapshot& snapshot, const BackendOpti
     return residuals::PoseUncertaintyWhitening(camera, state->poses[slot], T_base_cam, p_map,
                                                options.pixel_sigma_px, sigma_t, sigma_r);
   };
+  // Markings seen only in partial views see the extrinsic through a held copy.
+  PoseBlocks held_extrinsic = state->extrinsic;
+  bool extrinsic_held_used = false;
+  auto extrinsic_for = [&](std::size_t marking, double** q, double** t) {
+    const bool held = snapshot.markings[marking].partial_only;
+    extrinsic_held_used = extrinsic_held_used || held;
+    *q = held ? held_extrinsic.q : q_bc;
+    *t = held ? held_extrinsic.t : t_bc;
+  };
   if (options.optimize_markings) {
     for (const CornerMeasurement& m : state->corner_measurements) {
       const PoseBlocks& pose = state->frames[m.slot];
       auto& corner = state->corners[m.marking][m.corner];
+      double *q = nullptr, *t = nullptr;
+      extrinsic_for(m.marking, &q, &t);
       problem.AddResidualBlock(residuals::CornerReprojectionMapStepResidual::Create(
                                    camera, m.uv, whitening(m.slot, corner), pose.q, pose.t),
-                               loss, corner.data(), q_bc, t_bc);
+                               loss, corner.data(), q, t);
       ++*blocks;
     }
     for (const EdgeMeasurement& m : state->edge_measurements) {
       const PoseBlocks& pose = state->frames[m.slot];
       auto& corners = state->corners[m.marking];
+      double *q = nullptr, *t = nullptr;
+      extrinsic_for(m.marking, &q, &t);
       problem.AddResidualBlock(residuals::EdgeReprojectionMapStepResidual::Create(
                                    camera, m.uv, options.pixel_sigma_px, pose.q, pose.t),
-                               loss, corners[m.side].data(), corners[(m.side + 1) % 4].data(), q_bc,
-                               t_bc);
+                               loss, corners[m.side].data(), corners[(m.side + 1) % 4].data(), q,
+                               t);
       ++*blocks;
     }
+  }
+  if (extrinsic_held_used) {
+    problem.SetManifold(held_extrinsic.q, new ceres::EigenQuaternionManifold);
+    problem.SetParameterBlockConstant(held_extrinsic.q);
+    problem.SetParameterBlockConstant(held_extrinsic.t);
   }
   for (const LanePixel& px : state->lane_pixels) {
     auto& cps = state->control_points[px.lane];

@@ -198,11 +198,16 @@ void WindowCoordinator::FinalGlobalSolve(double time_budget_s) {
   for (const MarkingElement* marking : markings) {
     const MarkingElement& m = *marking;
     if (!m.optimized || m.last_frame < start) continue;
+    const bool partial_only = !m.Complete() || std::none_of(m.history.begin(), m.history.end(),
+                                                            [](const MarkingMeasurement& meas) {
+                                                              return meas.Complete();
+                                                            });
     WindowMarking wm{m.id,
                      m.corners_map,
                      {},
                      store_->RoadDirectionAt(m.Center()),
-                     m.Observations() >= kMinMatureObservations};
+                     !partial_only && m.Observations() >= kMinMatureObservations,
+                     partial_only};
     std::copy_if(m.history.begin(), m.history.end(), std::back_inserter(wm.measurements), in_span);
     snapshot.markings.push_back(std::move(wm));
   }
@@ -269,14 +274,17 @@ WindowSnapshot WindowCoordinator::BuildSnapshot() {
     if (m.last_frame < first) continue;  // outside the window: held fixed
     if (!SeenUpClose(m)) continue;       // the front end's estimate until it is
     if (!m.confirmed) continue;          // tentative (maybe a spurious blob): no pull
-    // Seen only in partial views (larger than the view): the front end's extent, no pull on
-    // the extrinsic (on av2_pit_dev such crossings pulled the roll by 0.8 deg; open).
-    if (std::none_of(m.history.begin(), m.history.end(),
-                     [](const MarkingMeasurement& meas) { return meas.Complete(); })) {
-      continue;
-    }
-    WindowMarking wm{m.id, m.corners_map, m.history, store_->RoadDirectionAt(m.Center()),
-                     m.optimized && m.Observations() >= kMinMatureObservations};
+    // Seen only in partial views (larger than the view): refined with the extrinsic held,
+    // never correcting poses (on av2_pit_dev such crossings pulled the roll by 0.8 deg).
+    const bool partial_only =
+        std::none_of(m.history.begin(), m.history.end(),
+                     [](const MarkingMeasurement& meas) { return meas.Complete(); });
+    WindowMarking wm{m.id,
+                     m.corners_map,
+                     m.history,
+                     store_->RoadDirectionAt(m.Center()),
+                     !partial_only && m.optimized && m.Observations() >= kMinMatureObservations,
+                     partial_only};
     for (const MarkingMeasurement& meas : m.history) {
       if (meas.frame_index < first) context.insert(meas.frame_index);
     }
