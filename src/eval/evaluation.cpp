@@ -109,6 +109,7 @@ MarkingMetrics EvaluateMarkings(const VectorMap& map, const GroundTruth& gt,
     result.class_id = m.class_id;
     result.class_name = m.class_name;
     result.center_map = m.Center();
+    result.complete = m.Complete();
     metrics.map_markings.push_back(result);
   }
   for (const GroundTruthMarking& g : gt.markings) {
@@ -149,7 +150,7 @@ MarkingMetrics EvaluateMarkings(const VectorMap& map, const GroundTruth& gt,
     ++metrics.gt_markings[c.gt_index].duplicates;
   }
 
-  std::vector<double> center_errors, corner_errors;
+  std::vector<double> center_errors, corner_errors, complete_center_errors;
   Eigen::Vector3d abs_sum = Eigen::Vector3d::Zero(), signed_sum = Eigen::Vector3d::Zero();
   for (const MapMarkingResult& m : metrics.map_markings) {
     if (m.verdict == MarkingVerdict::kDuplicate) ++metrics.duplicates;
@@ -158,6 +159,11 @@ MarkingMetrics EvaluateMarkings(const VectorMap& map, const GroundTruth& gt,
       continue;
     }
     ++metrics.matched;
+    if (m.complete) {
+      complete_center_errors.push_back(m.center_error_m);
+    } else {
+      ++metrics.matched_incomplete;
+    }
     center_errors.push_back(m.center_error_m);
     corner_errors.push_back(m.corner_error_m);
     abs_sum += m.center_error_map.cwiseAbs();
@@ -167,6 +173,7 @@ MarkingMetrics EvaluateMarkings(const VectorMap& map, const GroundTruth& gt,
     metrics.matched_visible += g.matched && g.visible_frames > 0 ? 1 : 0;
   }
   metrics.center_error_m = Summarize(center_errors);
+  metrics.center_error_complete_m = Summarize(complete_center_errors);
   metrics.corner_error_m = Summarize(corner_errors);
   if (metrics.matched > 0) {
     metrics.mean_abs_error_xyz_m = abs_sum / metrics.matched;

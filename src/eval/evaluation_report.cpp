@@ -51,6 +51,8 @@ void AddMarkings(const MarkingMetrics& m, nlohmann::json* j) {
   (*j)["marking_map_total"] = m.map_total;
   (*j)["marking_unmatched"] = m.unmatched_map;
   (*j)["marking_duplicates"] = m.duplicates;
+  (*j)["marking_matched_incomplete"] = m.matched_incomplete;
+  (*j)["marking_ape_complete_mean_m"] = Number(m.center_error_complete_m.mean);
   nlohmann::json markings = nlohmann::json::array();
   for (const MapMarkingResult& r : m.map_markings) {
     markings.push_back({{"map_id", r.map_id},
@@ -61,7 +63,8 @@ void AddMarkings(const MarkingMetrics& m, nlohmann::json* j) {
                         {"center_map", Vector(r.center_map)},
                         {"center_err_xyz_m", Vector(r.center_error_map)},
                         {"center_err_m", Number(r.center_error_m)},
-                        {"corner_err_m", Number(r.corner_error_m)}});
+                        {"corner_err_m", Number(r.corner_error_m)},
+                        {"complete", r.complete}});
   }
   (*j)["markings"] = markings;
   nlohmann::json gt_markings = nlohmann::json::array();

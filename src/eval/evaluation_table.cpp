@@ -75,6 +75,9 @@ void AddMarkingRows(const Metrics& metrics, Table* t) {
   t->Row("map markings: matched / all", Count(m.matched, m.map_total), "", "");
   t->Row("unmatched / of which duplicates",
          std::to_string(m.unmatched_map) + " / " + std::to_string(m.duplicates), "", "");
+  t->Row("matched but not closed (complete: false)", std::to_string(m.matched_incomplete), "", "");
+  t->Row("center APE mean, closed markings only", Fixed(m.center_error_complete_m.mean, 3), "",
+         "m");
 }
 
 void AddLaneRows(const Metrics& metrics, Table* t) {

@@ -24,6 +24,8 @@ ipm_road_mapper::MarkingPolygon ToMarkingMsg(const MapMarking& marking) {
   m.observations = marking.observations;
   m.first_seen = SafeTime(marking.first_seen);
   m.last_seen = SafeTime(marking.last_seen);
+  for (int i = 0; i < 4; ++i) m.sides_measured[i] = marking.sides_measured[i];
+  m.complete = marking.Complete();
   return m;
 }
 
@@ -70,6 +72,7 @@ VectorMap FromVectorMapMsg(const ipm_road_mapper::VectorMapMsg& msg) {
     marking.observations = m.observations;
     marking.first_seen = ToSeconds(m.first_seen);
     marking.last_seen = ToSeconds(m.last_seen);
+    for (int i = 0; i < 4; ++i) marking.sides_measured[i] = m.sides_measured[i] != 0;
     map.markings.push_back(marking);
   }
   for (const auto& l : msg.lanes) {

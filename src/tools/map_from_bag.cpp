@@ -252,7 +252,8 @@ std::string Summary(const Arguments& args, const Mapper& mapper, const FrameAsse
     << "extraction: " << e.instances_seen << " instances; dropped: unknown class "
     << e.dropped_unknown_class << ", tiny " << e.dropped_tiny << ", border " << e.dropped_border
     << ", range " << e.dropped_range << ", degenerate " << e.dropped_degenerate
-    << ", instance limit " << e.dropped_instance_limit << "\n"
+    << ", instance limit " << e.dropped_instance_limit << "; partial markings kept "
+    << e.partial_markings << "\n"
     << "implausible: " << e.dropped_oversized << " oversized markings, " << e.dropped_wide_lane
     << " wide lanes (" << e.lane_runs_too_wide
     << " lane runs too wide), frames without observations: " << e.frames_too_many_instances

@@ -98,8 +98,11 @@ TEST_F(AbsurdMasksTest, WholeImageMarking) {
   const cv::Mat mask(720, 1280, CV_16UC1, cv::Scalar(kArrow + 1));
   const FrameObservations obs = Extract(mask);
   ExpectNothing(obs);
-  // Truncated by the border before any frame-level statistic.
-  EXPECT_EQ(obs.counters.dropped_border, 1u);
+  // Cut by the border on every side and by the horizon: no observation, counted once (its
+  // part below the horizon is centred beyond the marking range).
+  EXPECT_EQ(
+      obs.counters.dropped_range + obs.counters.dropped_oversized + obs.counters.dropped_border,
+      1u);
 }
 
 TEST_F(AbsurdMasksTest, MarkingCoveringMostOfTheRoadDropsTheFrame) {
@@ -248,6 +251,48 @@ TEST(AbsurdFramesInTheMapper, FrameIsUsedForThePoseButAddsNoElement) {
   }
   EXPECT_EQ(mapper.map().markings.size(), 1u);
   EXPECT_EQ(mapper.map().lanes.size(), 1u);
+}
+
+TEST(AbsurdFramesInTheMapper, BadMarkingInstancesAreCountedAndLeaveTheMap) {
+  // A mapped arrow, then frames each with one bad marking instance on top of the road:
+  // the whole image, a 1-px sliver, a blob leaving the image on three sides, 10,000 tiny
+  // instances. Each is counted by its reason; the map keeps its one arrow.
+  Mapper mapper = MakeMapper();
+  for (int k = 0; k < 6; ++k) mapper.ProcessFrame(test::RoadFrame(100.0 + 0.05 * k, 0.5 * k));
+  ASSERT_EQ(mapper.ExportMap(ExportOptions()).markings.size(), 1u);
+  const std::uint64_t id = mapper.ExportMap(ExportOptions()).markings[0].id;
+  std::vector<FrameInput> bad;
+  bad.push_back(test::RoadFrame(100.30, 3.0));
+  bad.back().mask.setTo(cv::Scalar(10900));
+  bad.push_back(test::RoadFrame(100.35, 3.5));
+  bad.back().mask(cv::Rect(100, 400, 900, 1)).setTo(cv::Scalar(10901));
+  bad.push_back(test::RoadFrame(100.40, 4.0));
+  bad.back().mask(cv::Rect(0, 560, 1280, 160)).setTo(cv::Scalar(10902));
+  // 10,000 one-pixel instances on an otherwise empty mask: every known value of the test
+  // classes (tiny) and the rest of unknown classes.
+  bad.push_back(test::RoadFrame(100.45, 4.5));
+  bad.back().mask.setTo(cv::Scalar(0));
+  std::vector<std::uint16_t> values = KnownValues(test::TestClasses(), 10000);
+  const std::size_t known = values.size();
+  for (std::size_t i = known; i < 10000; ++i)
+    values.push_back(static_cast<std::uint16_t>(30000 + i));
+  for (std::size_t i = 0; i < values.size(); ++i) {
+    bad.back().mask.at<std::uint16_t>(380 + 2 * static_cast<int>(i / 400),
+                                      2 + 3 * static_cast<int>(i % 400)) = values[i];
+  }
+  const ExtractionCounters before = mapper.counters().extraction;
+  for (const FrameInput& frame : bad) ASSERT_EQ(mapper.ProcessFrame(frame), FrameStatus::kUsed);
+  const ExtractionCounters& c = mapper.counters().extraction;
+  EXPECT_GE(c.dropped_border + c.dropped_range + c.dropped_oversized -
+                (before.dropped_border + before.dropped_range + before.dropped_oversized),
+            2u);  // whole image, three sides
+  EXPECT_GT(c.dropped_degenerate + c.dropped_tiny, before.dropped_degenerate + before.dropped_tiny);
+  EXPECT_EQ(c.dropped_tiny - before.dropped_tiny, known);  // the tiny instances
+  EXPECT_EQ(c.dropped_unknown_class - before.dropped_unknown_class, values.size() - known);
+  // The exported map keeps its one arrow (a bad instance is at most a tentative element).
+  const VectorMap exported = mapper.ExportMap(ExportOptions());
+  ASSERT_EQ(exported.markings.size(), 1u);
+  EXPECT_EQ(exported.markings[0].id, id);
 }
 
 // The error message of loading `yaml` as the `extraction` section.

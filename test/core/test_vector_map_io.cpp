@@ -54,7 +54,8 @@ VectorMap MakeMap() {
   marking.first_seen = 1700000000.05;
   marking.last_seen = 1700000001.55;
   map.markings.push_back(marking);
-  marking.id = 18446744073709551615ULL;  // the largest id must survive too
+  marking.id = 18446744073709551615ULL;                 // the largest id must survive too
+  marking.sides_measured = {true, false, true, false};  // a crossing wider than the view
   map.markings.push_back(marking);
   MapLane lane;
   lane.id = 3;
@@ -94,6 +95,7 @@ void ExpectMapsEqual(const VectorMap& a, const VectorMap& b) {
     EXPECT_EQ(a.markings[i].observations, b.markings[i].observations);
     EXPECT_NEAR(a.markings[i].first_seen, b.markings[i].first_seen, 1e-9);
     EXPECT_NEAR(a.markings[i].last_seen, b.markings[i].last_seen, 1e-9);
+    EXPECT_EQ(a.markings[i].sides_measured, b.markings[i].sides_measured);
     for (int k = 0; k < 4; ++k) {
       EXPECT_LT((a.markings[i].corners_map[k] - b.markings[i].corners_map[k]).norm(), 1e-9);
     }
@@ -161,6 +163,30 @@ TEST_F(MapIoTest, MapRoundTripIsExactAndLeavesNoTemporaryFile) {
   EXPECT_EQ(files, 1);
   // And through the in-memory JSON conversion.
   ExpectMapsEqual(map, VectorMapFromJson(VectorMapToJson(map)));
+}
+
+TEST_F(MapIoTest, MarkingSideFlagsAreWrittenAndOptionalOnRead) {
+  const VectorMap map = MakeMap();
+  const nlohmann::json j = VectorMapToJson(map);
+  EXPECT_EQ(j["markings"][0]["complete"], true);
+  EXPECT_EQ(j["markings"][1]["complete"], false);
+  EXPECT_EQ(j["markings"][1]["sides_measured"], nlohmann::json({true, false, true, false}));
+  // A map written before the flags existed: every marking a whole view.
+  nlohmann::json old = j;
+  for (auto& m : old["markings"]) {
+    m.erase("complete");
+    m.erase("sides_measured");
+  }
+  for (const MapMarking& m : VectorMapFromJson(old).markings) EXPECT_TRUE(m.Complete());
+  // `complete` alone sets all four; malformed flags are one-line errors.
+  nlohmann::json only_complete = old;
+  only_complete["markings"][0]["complete"] = false;
+  EXPECT_FALSE(VectorMapFromJson(only_complete).markings[0].Complete());
+  nlohmann::json bad = j;
+  bad["markings"][0]["sides_measured"] = {true, true, true};
+  EXPECT_THROW(VectorMapFromJson(bad), MapFormatError);
+  bad["markings"][0]["sides_measured"] = {true, 1, true, true};
+  EXPECT_THROW(VectorMapFromJson(bad), MapFormatError);
 }
 
 TEST_F(MapIoTest, SaveRefusesNaNAndKeepsTheOldFile) {

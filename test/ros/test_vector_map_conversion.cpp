@@ -21,6 +21,7 @@ VectorMap SomeMap() {
   m.corners_map = {Eigen::Vector3d(10, -0.6, 0.1), Eigen::Vector3d(13, -0.6, 0.1),
                    Eigen::Vector3d(13, 0.6, 0.12), Eigen::Vector3d(10, 0.6, 0.12)};
   m.observations = 5;
+  m.sides_measured = {true, true, false, true};  // extent not closed on one side
   m.first_seen = 1000.25;
   m.last_seen = 1001.5;
   map.markings.push_back(m);
@@ -68,6 +69,9 @@ TEST(VectorMapConversion, RoundTripKeepsEveryField) {
   EXPECT_EQ(back.markings[0].id, 11u);
   EXPECT_EQ(back.markings[0].class_name, "arrow_straight");
   EXPECT_EQ(back.markings[0].observations, 5);
+  EXPECT_FALSE(msg.markings[0].complete);
+  EXPECT_FALSE(msg.markings[0].sides_measured[2]);
+  EXPECT_EQ(back.markings[0].sides_measured, map.markings[0].sides_measured);
   EXPECT_NEAR(back.markings[0].first_seen, 1000.25, 1e-9);
   for (int i = 0; i < 4; ++i) {
     EXPECT_TRUE(back.markings[0].corners_map[i].isApprox(map.markings[0].corners_map[i]));

@@ -63,6 +63,7 @@ struct MapMarkingResult {
   Eigen::Vector3d center_error_map = Eigen::Vector3d::Constant(kNoValue);  // map - GT
   double center_error_m = kNoValue;
   double corner_error_m = kNoValue;  // mean corner distance, best cyclic order
+  bool complete = true;              // the map says every side was measured (MapMarking::Complete)
 };
 
 // Per GT marking: whether the map has it.
@@ -85,8 +86,12 @@ struct MarkingMetrics {
   int matched_visible = 0;
   int unmatched_map = 0;  // map markings without a match (duplicates included)
   int duplicates = 0;
-  double recall = kNoValue;     // matched_visible / gt_visible
-  double precision = kNoValue;  // matched / map_total
+  // Matched markings whose extent the map did not close (`complete: false`): their center is
+  // a lower-bound rectangle's, so they are counted and their APE reported apart as well.
+  int matched_incomplete = 0;
+  ErrorSummary center_error_complete_m;  // center APE over matched complete markings only
+  double recall = kNoValue;              // matched_visible / gt_visible
+  double precision = kNoValue;           // matched / map_total
   ErrorSummary center_error_m;
   ErrorSummary corner_error_m;
   Eigen::Vector3d mean_abs_error_xyz_m = Eigen::Vector3d::Constant(kNoValue);

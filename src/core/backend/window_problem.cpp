@@ -12,6 +12,7 @@
 #include "ipm_road_mapper/core/backend/extrinsic_observability.h"
 #include "ipm_road_mapper/core/backend/residuals/along_lane_anchor_residual.h"
 #include "ipm_road_mapper/core/backend/residuals/corner_reprojection_residual.h"
+#include "ipm_road_mapper/core/backend/residuals/edge_reprojection_residual.h"
 #include "ipm_road_mapper/core/backend/residuals/extrinsic_prior_residual.h"
 #include "ipm_road_mapper/core/backend/residuals/lane_smoothness_residual.h"
 #include "ipm_road_mapper/core/backend/residuals/motion_prior_residual.h"
@@ -55,6 +56,15 @@ struct CornerMeasurement {
   Eigen::Vector2d uv;
 };
 
+// One pixel on a measured side of a partial view whose corner the view cut (the edge
+// residual): which marking, side (corners side and side + 1) and frame slot.
+struct EdgeMeasurement {
+  std::size_t marking = 0;
+  int side = 0;
+  std::size_t slot = 0;
+  Eigen::Vector2d uv;
+};
+
 // One lane pixel: which lane, frame slot and spline segment (the segment's control points
 // are c[segment] .. c[segment + 3]; PPSR uses c[segment + 1], c[segment + 2]).
 struct LanePixel {
@@ -75,6 +85,8 @@ struct WindowState {
   std::vector<std::array<Eigen::Vector3d, 4>> corners;
   std::vector<std::vector<Eigen::Vector3d>> control_points;
   std::vector<CornerMeasurement> corner_measurements;
+  std::vector<EdgeMeasurement> edge_measurements;
+  PoseBlocks held_extrinsic;  // the extrinsic as partial-only markings see it (held)
   std::vector<LanePixel> lane_pixels;
   std::vector<Eigen::Isometry3d> poses;  // the frames' poses at the start (road surface)
   std::vector<bool> optimized;           // free in a pose step (WindowFrame::optimized)
@@ -90,7 +102,8 @@ struct WindowState {
   // What the last map step with the extrinsic free found about it.
   ExtrinsicObservability observability;
   bool observability_valid = false;
-  explicit WindowState(const WindowSnapshot& s) : extrinsic(s.T_base_cam) {
+  explicit WindowState(const WindowSnapshot& s)
+      : extrinsic(s.T_base_cam), held_extrinsic(s.T_base_cam) {
     for (std::size_t i = 0; i < s.frames.size(); ++i) {
       frames.emplace_back(s.frames[i].T_map_base);
       poses.push_back(s.frames[i].T_map_base);
@@ -131,15 +144,24 @@ void CollectCornerMeasurements(const WindowSnapshot& snapshot, const BackendOpti
         RoadSurfaceNear(state->poses, center, options.road_plane_radius_m).plane;
     const Eigen::Vector3d& axis = snapshot.markings[m].axis_map;
     const auto& measurements = snapshot.markings[m].measurements;
+    // Partial views measure a marking no whole view shows (one larger than the view); where
+    // whole views exist they alone are measurements (see docs/backend.md, "Partial views").
+    const bool seen_whole =
+        std::any_of(measurements.begin(), measurements.end(),
+                    [](const MarkingMeasurement& meas) { return meas.Complete(); });
+    std::vector<std::size_t> usable;
+    for (std::size_t i = 0; i < measurements.size(); ++i) {
+      if (!seen_whole || measurements[i].Complete()) usable.push_back(i);
+    }
     // At most max_measurements_per_marking of them, spread over the history (the first and
     // the last included): neighbouring frames see a marking almost alike.
     const std::size_t cap = static_cast<std::size_t>(options.max_measurements_per_marking);
     std::vector<std::size_t> chosen;
-    if (measurements.size() <= cap) {
-      for (std::size_t i = 0; i < measurements.size(); ++i) chosen.push_back(i);
+    if (usable.size() <= cap) {
+      chosen = usable;
     } else {
       for (std::size_t k = 0; k < cap; ++k) {
-        chosen.push_back(k * (measurements.size() - 1) / (cap - 1));
+        chosen.push_back(usable[k * (usable.size() - 1) / (cap - 1)]);
       }
     }
     for (std::size_t i : chosen) {
@@ -147,7 +169,9 @@ void CollectCornerMeasurements(const WindowSnapshot& snapshot, const BackendOpti
       const auto slot = state->slot_of_frame.find(meas.frame_index);
       if (slot == state->slot_of_frame.end()) continue;
       std::array<Eigen::Vector2d, 4> corners_uv = meas.corners_uv;
-      if (!meas.outline_uv.empty() && axis.norm() > 0.0) {
+      // Whole views are re-measured on the road plane; a partial view keeps its corners as
+      // labeled (its rectangle on another plane could move a cut side onto a measured one).
+      if (meas.Complete() && !meas.outline_uv.empty() && axis.norm() > 0.0) {
         const Eigen::Isometry3d T_map_cam = state->frames[slot->second].ToIsometry() * T_base_cam;
         std::array<Eigen::Vector2d, 4> on_plane;
         if (MeasureCornersOnPlane(camera, T_map_cam, plane, axis, corners, meas.outline_uv,
@@ -156,10 +180,19 @@ void CollectCornerMeasurements(const WindowSnapshot& snapshot, const BackendOpti
         }
       }
       for (int c = 0; c < 4; ++c) {
+        // A cut corner is no measurement (partial views): its sides may still be.
+        if (!meas.CornerMeasured(c) || !corners_uv[c].allFinite()) continue;
         if (!ProjectsNearImage(camera, *state, slot->second, corners[c],
                                options.max_outside_image_px))
           continue;
         state->corner_measurements.push_back({m, c, slot->second, corners_uv[c]});
+      }
+      for (int side = 0; side < 4; ++side) {
+        if (!meas.side_measured[side]) continue;
+        if (meas.CornerMeasured(side) && meas.CornerMeasured((side + 1) % 4)) continue;
+        for (const Eigen::Vector2d& uv : meas.side_uv[side]) {
+          state->edge_measurements.push_back({m, side, slot->second, uv});
+        }
       }
     }
   }
@@ -256,9 +289,24 @@ ceres::Solver::Summary Solve(const BackendOptions& options, double time_limit_s,
 void AddMapPointPriors(const BackendOptions& options, WindowState* state,
                        ceres::Problem* problem_ptr) {
   ceres::Problem& problem = *problem_ptr;
-  for (auto& corners : state->corners) {
-    for (auto& c : corners) {
+  // A corner that only edge residuals reach slides along its side at no cost: held loosely
+  // where it is (isotropic lane_anchor_across_sigma_m, as a lane's control point across its
+  // lane), the edges decide across the side.
+  std::vector<std::array<bool, 4>> has_corner_pixel(state->corners.size(),
+                                                    {{false, false, false, false}});
+  for (const CornerMeasurement& m : state->corner_measurements) {
+    has_corner_pixel[m.marking][m.corner] = true;
+  }
+  for (std::size_t k = 0; k < state->corners.size(); ++k) {
+    for (int i = 0; i < 4; ++i) {
+      auto& c = state->corners[k][i];
       if (!problem.HasParameterBlock(c.data())) continue;
+      if (!has_corner_pixel[k][i]) {
+        problem.AddResidualBlock(residuals::AlongLaneAnchorResidual::Create(
+                                     c, Eigen::Vector3d::Zero(), options.lane_anchor_along_sigma_m,
+                                     options.lane_anchor_across_sigma_m),
+                                 nullptr, c.data());
+      }
       if (options.optimize_z) AddRoadSurfacePrior(options, *state, c.data(), &problem);
       ConfigurePoint(options, c.data(), &problem);
     }
@@ -336,16 +384,45 @@ int AddMapStepMeasurements(const WindowSnapshot& snapshot, const BackendOptions&
     return residuals::PoseUncertaintyWhitening(camera, state->poses[slot], T_base_cam, p_map,
                                                options.pixel_sigma_px, sigma_t, sigma_r);
   };
+  // Markings seen only in partial views see the extrinsic through a held copy (docs/backend.md,
+  // "Partial views"): they are refined, but never move the extrinsic.
+  state->held_extrinsic = state->extrinsic;
+  bool extrinsic_held_used = false;
+  auto extrinsic_for = [&](std::size_t marking, double** q, double** t) {
+    const bool held = snapshot.markings[marking].partial_only;
+    extrinsic_held_used = extrinsic_held_used || held;
+    *q = held ? state->held_extrinsic.q : q_bc;
+    *t = held ? state->held_extrinsic.t : t_bc;
+  };
   if (options.optimize_markings) {
     for (const CornerMeasurement& m : state->corner_measurements) {
       if (!wanted(m.slot)) continue;
       const PoseBlocks& pose = state->frames[m.slot];
       auto& corner = state->corners[m.marking][m.corner];
+      double *q = nullptr, *t = nullptr;
+      extrinsic_for(m.marking, &q, &t);
       problem->AddResidualBlock(residuals::CornerReprojectionMapStepResidual::Create(
                                     camera, m.uv, whitening(m.slot, corner), pose.q, pose.t),
-                                loss, corner.data(), q_bc, t_bc);
+                                loss, corner.data(), q, t);
       ++blocks;
     }
+    for (const EdgeMeasurement& m : state->edge_measurements) {
+      if (!wanted(m.slot)) continue;
+      const PoseBlocks& pose = state->frames[m.slot];
+      auto& corners = state->corners[m.marking];
+      double *q = nullptr, *t = nullptr;
+      extrinsic_for(m.marking, &q, &t);
+      problem->AddResidualBlock(residuals::EdgeReprojectionMapStepResidual::Create(
+                                    camera, m.uv, options.pixel_sigma_px, pose.q, pose.t),
+                                loss, corners[m.side].data(), corners[(m.side + 1) % 4].data(), q,
+                                t);
+      ++blocks;
+    }
+  }
+  if (extrinsic_held_used) {
+    problem->SetManifold(state->held_extrinsic.q, new ceres::EigenQuaternionManifold);
+    problem->SetParameterBlockConstant(state->held_extrinsic.q);
+    problem->SetParameterBlockConstant(state->held_extrinsic.t);
   }
   for (const LanePixel& px : state->lane_pixels) {
     if (!wanted(px.slot)) continue;
@@ -458,6 +535,16 @@ ceres::Solver::Summary PoseStep(const WindowSnapshot& snapshot, const BackendOpt
         loss, pose.q, pose.t);
     ++*blocks;
   }
+  for (const EdgeMeasurement& m : state->edge_measurements) {
+    if (!snapshot.markings[m.marking].mature || !snapshot.frames[m.slot].in_window) continue;
+    PoseBlocks& pose = state->frames[m.slot];
+    const auto& corners = state->corners[m.marking];
+    problem.AddResidualBlock(residuals::EdgeReprojectionPoseStepResidual::Create(
+                                 camera, m.uv, options.pixel_sigma_px, corners[m.side],
+                                 corners[(m.side + 1) % 4], q_bc, t_bc),
+                             loss, pose.q, pose.t);
+    ++*blocks;
+  }
   if (options.lane_residual == LaneResidual::kPpsr) {
     for (const LanePixel& px : state->lane_pixels) {
       if (!snapshot.frames[px.slot].in_window) continue;  // a context frame's pose is data
@@ -530,7 +617,7 @@ void ObserveExtrinsic(const WindowSnapshot& snapshot, const BackendOptions& opti
   auto wanted = [&](std::size_t slot) { return !(state->hold_out && state->held_out[slot]); };
   if (options.optimize_markings) {
     for (const CornerMeasurement& m : state->corner_measurements) {
-      if (!wanted(m.slot)) continue;
+      if (!wanted(m.slot) || snapshot.markings[m.marking].partial_only) continue;
       PoseBlocks& pose = state->frames[m.slot];
       problem.AddResidualBlock(
           residuals::CornerReprojectionResidual::Create(camera, m.uv, options.pixel_sigma_px), loss,

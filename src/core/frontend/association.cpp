@@ -3,6 +3,7 @@
 #include <algorithm>
 #include <cmath>
 #include <limits>
+#include <opencv2/imgproc.hpp>
 #include <tuple>
 
 #include "ipm_road_mapper/core/geometry/catmull_rom_spline.h"
@@ -65,6 +66,38 @@ Eigen::Vector3d Mean(const std::array<Eigen::Vector3d, 4>& corners) {
 
 }  // namespace
 
+double OverlapOfSmaller(const std::array<Eigen::Vector3d, 4>& a,
+                        const std::array<Eigen::Vector3d, 4>& b) {
+  auto polygon = [](const std::array<Eigen::Vector3d, 4>& corners) {
+    std::vector<cv::Point2f> p;
+    for (const Eigen::Vector3d& c : corners) p.emplace_back(c.x(), c.y());
+    if (cv::contourArea(p, true) < 0.0) std::reverse(p.begin(), p.end());  // counterclockwise
+    return p;
+  };
+  const std::vector<cv::Point2f> pa = polygon(a), pb = polygon(b);
+  const double smaller = std::min(cv::contourArea(pa), cv::contourArea(pb));
+  if (!(smaller > 1e-6)) return 0.0;
+  std::vector<cv::Point2f> intersection;
+  const double area = cv::intersectConvexConvex(pa, pb, intersection, true);
+  return std::max(0.0, area) / smaller;
+}
+
+namespace {
+
+// Smallest area ratio of two whole views of one marking (see AssociateMarkings).
+constexpr double kMinAreaRatio = 1.0 / 3.0;
+
+// Area (x-y) of a 4-corner polygon.
+double RectangleArea(const std::array<Eigen::Vector3d, 4>& c) {
+  double twice = 0.0;
+  for (int i = 0; i < 4; ++i) {
+    twice += c[i].x() * c[(i + 1) % 4].y() - c[(i + 1) % 4].x() * c[i].y();
+  }
+  return 0.5 * std::abs(twice);
+}
+
+}  // namespace
+
 double MarkingFloorSigma(const AssociationOptions& options) {
   return std::hypot(options.marking_position_sigma_m, options.odometry_sigma_m);
 }
@@ -107,7 +140,22 @@ std::vector<int> AssociateMarkings(const std::vector<const MarkingElement*>& ele
   for (int c = 0; c < static_cast<int>(candidates.size()); ++c) {
     for (int e = 0; e < static_cast<int>(elements.size()); ++e) {
       if (elements[e]->class_id != candidates[c].class_id) continue;
-      const double cost = MarkingAssociationCost(*elements[e], candidates[c], options);
+      // Two whole views of one marking have about one area (IPM stretches a far view by
+      // tens of percent, not 3x): a blob inside a marking is not a view of it.
+      if (candidates[c].complete && elements[e]->Complete()) {
+        const double a = RectangleArea(candidates[c].corners_map);
+        const double b = RectangleArea(elements[e]->corners_map);
+        if (!(std::min(a, b) >= kMinAreaRatio * std::max(a, b))) continue;
+      }
+      double cost = MarkingAssociationCost(*elements[e], candidates[c], options);
+      if (!candidates[c].complete || !elements[e]->Complete()) {
+        // A partial view: the shared area decides (full overlap costs nothing).
+        const double overlap =
+            OverlapOfSmaller(elements[e]->corners_map, candidates[c].corners_map);
+        if (overlap >= options.marking_merge_overlap && overlap > 0.0) {
+          cost = std::min(cost, gate * (1.0 - overlap));
+        }
+      }
       if (cost <= gate) pairs.emplace_back(cost, c, e);
     }
   }

@@ -200,7 +200,7 @@ FrameObservations ExtractObservations(const cv::Mat& mask, const ClassTable& cla
   counters.instances_seen = scan.instances.size();
 
   // Cheap rejections from the scan's statistics, before any per-instance work.
-  std::vector<int> slots;
+  std::vector<int> slots, counted;  // candidates; those the frame statistics count
   std::vector<bool> is_lane(scan.instances.size(), false);
   for (int slot = 0; slot < static_cast<int>(scan.instances.size()); ++slot) {
     const InstanceStats& stats = scan.instances[slot];
@@ -215,14 +215,18 @@ FrameObservations ExtractObservations(const cv::Mat& mask, const ClassTable& cla
       ++counters.dropped_tiny;
       continue;
     }
-    if (!is_lane[slot] &&
-        TouchesBorder(stats, mask.cols, mask.rows, std::max(options.border_margin_px, 0))) {
-      ++counters.dropped_border;
-      continue;
-    }
     slots.push_back(slot);
+    // A marking cut by the border (a crossing wider than the view) is a partial view, no
+    // sign of a network gone wrong: the frame statistics leave it out, as they always did.
+    if (is_lane[slot] ||
+        !TouchesBorder(stats, mask.cols, mask.rows, std::max(options.border_margin_px, 0))) {
+      counted.push_back(slot);
+    }
   }
-  if (IsAbsurdFrame(scan, ipm, options, slots, &counters)) return observations;
+  if (IsAbsurdFrame(scan, ipm, options, counted, &counters)) {
+    counters.dropped_absurd_frame += slots.size() - counted.size();
+    return observations;
+  }
   ApplyInstanceLimit(scan, options.max_instances_per_frame, &slots, &counters);
 
   std::vector<int> offsets;
@@ -245,14 +249,18 @@ FrameObservations ExtractObservations(const cv::Mat& mask, const ClassTable& cla
       marking.class_id = ClassIdOf(stats.value);
       marking.instance_value = stats.value;
       marking.pixel_count = stats.pixel_count;
-      outcome = extraction::ExtractMarking(runs, stats.run_count, class_info, ipm, error_model,
-                                           options, &marking);
-      if (outcome == GeometryOutcome::kOk) observations.markings.push_back(marking);
+      outcome = extraction::ExtractMarking(runs, stats.run_count, mask, stats.value, classes, ipm,
+                                           error_model, options, &marking);
+      if (outcome == GeometryOutcome::kOk) {
+        if (!marking.Complete()) ++counters.partial_markings;
+        observations.markings.push_back(std::move(marking));
+      }
     }
     if (outcome == GeometryOutcome::kRange) ++counters.dropped_range;
     if (outcome == GeometryOutcome::kDegenerate) ++counters.dropped_degenerate;
     if (outcome == GeometryOutcome::kOversized) ++counters.dropped_oversized;
     if (outcome == GeometryOutcome::kTooWide) ++counters.dropped_wide_lane;
+    if (outcome == GeometryOutcome::kTruncated) ++counters.dropped_border;
   }
   return observations;
 }

@@ -3,11 +3,13 @@
 #include <algorithm>
 #include <array>
 #include <cmath>
+#include <limits>
 #include <numeric>
 #include <opencv2/imgproc.hpp>
 #include <vector>
 
 #include "instance_extraction_runs.h"
+#include "marking_outline.h"
 
 namespace ipm_road_mapper {
 namespace extraction {
@@ -222,18 +224,20 @@ void OrderCornersCanonically(std::array<Eigen::Vector3d, 4>* corners_base) {
   std::rotate(c.begin(), c.begin() + nearest, c.end());
 }
 
-GeometryOutcome ExtractMarking(const Run* runs, int run_count, const ClassInfo& class_info,
-                               const Ipm& ipm, const IpmErrorModel& error_model,
-                               const ExtractionOptions& options, MarkingObservation* marking) {
-  marking->outline_uv = SubpixelOutline(RowEnds(runs, SignificantPieces(runs, run_count)));
-  marking->outline_base.clear();
-  marking->outline_base.reserve(marking->outline_uv.size());
-  for (const Eigen::Vector2d& uv : marking->outline_uv) {
-    Eigen::Vector3d p_base;
-    // A point that does not map means the outline is cut by the horizon or the IPM range:
-    // the rectangle would be truncated, as at the image border.
-    if (ipm.PixelToGround(uv, &p_base) != IpmStatus::kOk) return GeometryOutcome::kRange;
-    marking->outline_base.push_back(p_base.head<2>());
+GeometryOutcome ExtractMarking(const Run* runs, int run_count, const cv::Mat& mask, int value,
+                               const ClassTable& classes, const Ipm& ipm,
+                               const IpmErrorModel& error_model, const ExtractionOptions& options,
+                               MarkingObservation* marking) {
+  std::vector<Eigen::Vector2d> outline_uv =
+      SubpixelOutline(RowEnds(runs, SignificantPieces(runs, run_count)));
+  const std::vector<std::uint8_t> edge_cut =
+      CutEdges(&outline_uv, mask, value, classes, std::max(options.border_margin_px, 0));
+  const ClassInfo& class_info = *classes.Find(ClassIdOf(value));
+  // Where the outline does not map (cut by the horizon or the IPM range) it is clipped: the
+  // part in range is a partial view like one cut by the border.
+  if (!ClipOutlineToGround(ipm, outline_uv, edge_cut, &marking->outline_uv, &marking->outline_base,
+                           &marking->outline_edge_cut)) {
+    return GeometryOutcome::kRange;
   }
   // Along the vehicle's heading until the mapper knows the road's (SetMarkingRectangle).
   const std::array<Eigen::Vector2d, 4> rectangle =
@@ -244,10 +248,16 @@ GeometryOutcome ExtractMarking(const Run* runs, int run_count, const ClassInfo& 
       options.min_rectangle_side_m) {
     return GeometryOutcome::kDegenerate;
   }
+  // A cut view is at most as large as the marking: too large already is no marking.
   if (IsOversized(marking->outline_base, class_info)) return GeometryOutcome::kOversized;
-  return SetMarkingRectangle(ipm, error_model, Eigen::Vector2d::UnitX(), marking)
-             ? GeometryOutcome::kOk
-             : GeometryOutcome::kRange;
+  if (!SetMarkingRectangle(ipm, error_model, Eigen::Vector2d::UnitX(), marking)) {
+    return GeometryOutcome::kRange;
+  }
+  // A view that measures at most one side locates the marking in one direction at most
+  // (a whole-image blob, one leaving the image on three sides): truncated, no observation.
+  const std::array<bool, 4>& sides = marking->side_measured;
+  if (sides[0] + sides[1] + sides[2] + sides[3] < 2) return GeometryOutcome::kTruncated;
+  return GeometryOutcome::kOk;
 }
 GeometryOutcome ExtractLane(const Run* runs, int run_count, const ClassInfo& class_info,
                             const Ipm& ipm, const IpmErrorModel& error_model,
@@ -312,8 +322,13 @@ bool SetMarkingRectangle(const Ipm& ipm, const IpmErrorModel& error_model,
     marking->corners_base[i] = Eigen::Vector3d(rectangle[i].x(), rectangle[i].y(), 0.0);
   }
   extraction::OrderCornersCanonically(&marking->corners_base);
+  extraction::LabelSides(marking);
   for (int i = 0; i < 4; ++i) {
-    if (!ipm.BaseToPixel(marking->corners_base[i], &marking->corners_uv[i])) return false;
+    // A cut corner is no measurement: it may lie behind the camera (a crossing passed over).
+    if (!ipm.BaseToPixel(marking->corners_base[i], &marking->corners_uv[i])) {
+      if (marking->CornerMeasured(i)) return false;
+      marking->corners_uv[i] = Eigen::Vector2d::Constant(std::numeric_limits<double>::quiet_NaN());
+    }
   }
   marking->center_base = 0.25 * (marking->corners_base[0] + marking->corners_base[1] +
                                  marking->corners_base[2] + marking->corners_base[3]);

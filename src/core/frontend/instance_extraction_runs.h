@@ -49,19 +49,22 @@ struct MaskRuns {
 MaskRuns ScanMask(const cv::Mat& mask);
 
 // Why the geometry of one instance was rejected.
-enum class GeometryOutcome { kOk, kRange, kDegenerate, kOversized, kTooWide };
+enum class GeometryOutcome { kOk, kRange, kDegenerate, kOversized, kTooWide, kTruncated };
 
-// Marking rectangle from the runs of one instance (row-major). The outline is the sub-pixel
-// convex outline of the instance's significant 8-connected pieces (all glyphs of a text
-// marking; specks below a tenth of the largest piece are debris). All of its points are
-// mapped to the ground (any failure: kRange, the marking is cut by the horizon or
-// the IPM range), then the rectangle along base_link's x axis is set (SetMarkingRectangle).
-// The rectangle's center also gets the x-y block of Omega_p at its pixel (center_cov_base).
-// kOversized when the outline's minimum-area ground rectangle is longer than
-// class_info.max_length_m or wider than class_info.max_width_m.
-GeometryOutcome ExtractMarking(const Run* runs, int run_count, const ClassInfo& class_info,
-                               const Ipm& ipm, const IpmErrorModel& error_model,
-                               const ExtractionOptions& options, MarkingObservation* marking);
+// Marking rectangle from the runs of one instance `value` of `mask` (row-major). The
+// outline is the sub-pixel convex outline of the instance's significant 8-connected pieces
+// (all glyphs of a text marking; specks below a tenth of the largest piece are debris); its
+// edges along the image border or next to another instance's pixels are cut
+// (marking_outline.h), and it is clipped to where the IPM maps (nothing maps: kRange). Then
+// the rectangle along base_link's x axis is set (SetMarkingRectangle) and its sides labeled
+// measured or cut; kTruncated when fewer than two sides are measured. The rectangle's center also
+// gets the x-y block of Omega_p at its pixel (center_cov_base). kOversized when the outline's
+// minimum-area ground rectangle is longer than its class's max_length_m or wider than its
+// max_width_m. `value`'s class must be in `classes`.
+GeometryOutcome ExtractMarking(const Run* runs, int run_count, const cv::Mat& mask, int value,
+                               const ClassTable& classes, const Ipm& ipm,
+                               const IpmErrorModel& error_model, const ExtractionOptions& options,
+                               MarkingObservation* marking);
 
 // Lane centerline points from the runs of one instance (row-major): every
 // options.lane_row_step rows from the bottom row up, the center of each run of that row

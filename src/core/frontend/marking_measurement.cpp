@@ -40,12 +40,28 @@ bool MeasureCornersOnPlane(const PinholeCamera& camera, const Eigen::Isometry3d&
   const std::array<Eigen::Vector3d, 4> corners = {
       plane.point + a_min * axis + c_min * across, plane.point + a_max * axis + c_min * across,
       plane.point + a_max * axis + c_max * across, plane.point + a_min * axis + c_max * across};
-  // The corners in the reference's order: reference[i] ~ corners[(i + shift) % 4].
-  const int shift = BestCyclicShift(reference_corners_map, corners, nullptr);
+  // The corners in the reference's order: reference[i] ~ corners[(i + shift) % 4], the shift
+  // that runs the sides alike (a partial view's rectangle is smaller than the reference:
+  // the nearest corners need not be the same ones).
+  int shift = 0;
+  double best = -std::numeric_limits<double>::infinity();
+  for (int k = 0; k < 4; ++k) {
+    double agreement = 0.0;
+    for (int i = 0; i < 4; ++i) {
+      agreement += (reference_corners_map[(i + 1) % 4] - reference_corners_map[i])
+                       .normalized()
+                       .dot((corners[(i + 1 + k) % 4] - corners[(i + k) % 4]).normalized());
+    }
+    if (agreement > best) {
+      best = agreement;
+      shift = k;
+    }
+  }
   const Eigen::Isometry3d T_cam_map = T_map_cam.inverse();
   for (int i = 0; i < 4; ++i) {
+    // A corner behind the camera is one a partial view cut: NaN, never a measurement.
     if (!camera.Project(Eigen::Vector3d(T_cam_map * corners[(i + shift) % 4]), &(*corners_uv)[i])) {
-      return false;
+      (*corners_uv)[i] = Eigen::Vector2d::Constant(std::numeric_limits<double>::quiet_NaN());
     }
   }
   return true;

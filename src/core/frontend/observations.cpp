@@ -7,6 +7,7 @@ void ExtractionCounters::Add(const ExtractionCounters& o) {
   dropped_unknown_class += o.dropped_unknown_class;
   dropped_tiny += o.dropped_tiny;
   dropped_border += o.dropped_border;
+  partial_markings += o.partial_markings;
   dropped_range += o.dropped_range;
   dropped_degenerate += o.dropped_degenerate;
   dropped_instance_limit += o.dropped_instance_limit;

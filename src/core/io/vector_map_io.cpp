@@ -30,7 +30,10 @@ nlohmann::json MarkingToJson(const MapMarking& m) {
           {"corners", corners},
           {"observations", m.observations},
           {"first_seen", m.first_seen},
-          {"last_seen", m.last_seen}};
+          {"last_seen", m.last_seen},
+          {"complete", m.Complete()},
+          {"sides_measured",
+           {m.sides_measured[0], m.sides_measured[1], m.sides_measured[2], m.sides_measured[3]}}};
 }
 
 nlohmann::json LaneToJson(const MapLane& lane) {
@@ -64,6 +67,21 @@ MapMarking MarkingFromJson(const nlohmann::json& j, const std::string& where) {
   m.observations = json_io::OptionalInt(j, "observations", 0, where);
   m.first_seen = json_io::OptionalNumber(j, "first_seen", 0.0, where);
   m.last_seen = json_io::OptionalNumber(j, "last_seen", 0.0, where);
+  // Older maps have no side flags: every marking was a whole view.
+  if (j.contains("sides_measured")) {
+    const std::string sides_where = Key(where, "sides_measured");
+    const nlohmann::json& sides = json_io::ReadArray(j.at("sides_measured"), sides_where);
+    if (sides.size() != 4) {
+      Fail(sides_where, "expected 4 flags, got " + std::to_string(sides.size()));
+    }
+    for (std::size_t k = 0; k < 4; ++k) {
+      if (!sides[k].is_boolean()) Fail(Index(sides_where, k), "expected true or false");
+      m.sides_measured[k] = sides[k].get<bool>();
+    }
+  } else if (j.contains("complete")) {
+    if (!j.at("complete").is_boolean()) Fail(Key(where, "complete"), "expected true or false");
+    m.sides_measured.fill(j.at("complete").get<bool>());
+  }
   return m;
 }
 

@@ -145,13 +145,14 @@ VectorMap Mapper::ExportMap(const ExportOptions& export_options) const {
     const ClassInfo* info = classes_.Find(class_id);
     return info ? info->name : std::string("class_") + std::to_string(class_id);
   };
-  // An element seen once is tentative (a spurious blob, until seen again): not exported.
+  // A tentative marking (seen once, or not yet consistently where it should have been
+  // visible: MarkingTracker::CheckConsistency) is not exported.
   std::vector<const MarkingElement*> markings;
   for (const MarkingElement& m : store_.markings()) markings.push_back(&m);
   for (const MarkingElement& m : store_.retired_markings()) markings.push_back(&m);
   for (const MarkingElement* element_ptr : markings) {
     const MarkingElement& element = *element_ptr;
-    if (element.Observations() < 2) continue;
+    if (element.Observations() < 2 || !element.confirmed) continue;
     MapMarking marking;
     marking.id = element.id;
     marking.class_id = element.class_id;
@@ -160,6 +161,7 @@ VectorMap Mapper::ExportMap(const ExportOptions& export_options) const {
     marking.observations = static_cast<int>(element.Observations());
     marking.first_seen = element.first_seen;
     marking.last_seen = element.last_seen;
+    marking.sides_measured = element.side_measured;
     out.markings.push_back(marking);
   }
   const bool refit = !windows_.LanesRefined();

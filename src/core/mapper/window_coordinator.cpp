@@ -158,7 +158,11 @@ void WindowCoordinator::RetireMarking(MarkingElement* marking) {
   const RoadSurfaceEstimate road = store_->RoadSurfaceAt(marking->Center());
   const RoadPlane& plane = road.plane;
   const Eigen::Vector3d axis = store_->RoadDirectionAt(marking->Center());
+  // As in the window problem: partial views only for a marking no whole view shows.
+  const bool seen_whole = std::any_of(marking->history.begin(), marking->history.end(),
+                                      [](const MarkingMeasurement& m) { return m.Complete(); });
   for (const MarkingMeasurement& m : marking->history) {
+    if (seen_whole && !m.Complete()) continue;
     const Eigen::Isometry3d& T_map_base = store_->frames()[m.frame_index].T_map_base;
     std::array<Eigen::Vector2d, 4> corners_uv = m.corners_uv;
     if (axis.norm() > 0.0 && !m.outline_uv.empty()) {
@@ -168,7 +172,11 @@ void WindowCoordinator::RetireMarking(MarkingElement* marking) {
         corners_uv = on_plane;
       }
     }
-    for (int c = 0; c < 4; ++c) input.corners.push_back({c, corners_uv[c], T_map_base});
+    for (int c = 0; c < 4; ++c) {
+      // Only corners the view measured (a partial view's cut corners are where it ended).
+      if (!m.CornerMeasured(c) || !corners_uv[c].allFinite()) continue;
+      input.corners.push_back({c, corners_uv[c], T_map_base});
+    }
   }
   if (options_.backend.optimize_z) {
     for (int c = 0; c < 4; ++c) {
@@ -206,11 +214,16 @@ void WindowCoordinator::FinalGlobalSolve(double time_budget_s) {
   for (const MarkingElement* marking : markings) {
     const MarkingElement& m = *marking;
     if (!m.optimized || m.last_frame < start) continue;
+    const bool partial_only = !m.Complete() || std::none_of(m.history.begin(), m.history.end(),
+                                                            [](const MarkingMeasurement& meas) {
+                                                              return meas.Complete();
+                                                            });
     WindowMarking wm{m.id,
                      m.corners_map,
                      {},
                      store_->RoadDirectionAt(m.Center()),
-                     m.Observations() >= kMinMatureObservations};
+                     !partial_only && m.Observations() >= kMinMatureObservations,
+                     partial_only};
     std::copy_if(m.history.begin(), m.history.end(), std::back_inserter(wm.measurements), in_span);
     snapshot.markings.push_back(std::move(wm));
   }
@@ -276,8 +289,18 @@ WindowSnapshot WindowCoordinator::BuildSnapshot() {
   for (const MarkingElement& m : store_->markings()) {
     if (m.last_frame < first) continue;  // outside the window: held fixed
     if (!SeenUpClose(m)) continue;       // the front end's estimate until it is
-    WindowMarking wm{m.id, m.corners_map, m.history, store_->RoadDirectionAt(m.Center()),
-                     m.optimized && m.Observations() >= kMinMatureObservations};
+    if (!m.confirmed) continue;          // tentative (maybe a spurious blob): no pull
+    // Seen only in partial views (larger than the view): refined with the extrinsic held,
+    // never correcting poses (on av2_pit_dev such crossings pulled the roll by 0.8 deg).
+    const bool partial_only =
+        std::none_of(m.history.begin(), m.history.end(),
+                     [](const MarkingMeasurement& meas) { return meas.Complete(); });
+    WindowMarking wm{m.id,
+                     m.corners_map,
+                     m.history,
+                     store_->RoadDirectionAt(m.Center()),
+                     !partial_only && m.optimized && m.Observations() >= kMinMatureObservations,
+                     partial_only};
     for (const MarkingMeasurement& meas : m.history) {
       if (meas.frame_index < first) context.insert(meas.frame_index);
     }

@@ -51,6 +51,9 @@ struct WindowMarking {
   // corrects poses (a new one is where flat-ground IPM put it, meters off, and poses
   // aligned to it would drift with it).
   bool mature = false;
+  // Seen only in partial views (larger than the view): its pixels refine it with the
+  // extrinsic held (their pull on it was wrong on av2_pit_dev: docs/backend.md).
+  bool partial_only = false;
 };
 
 // A lane observed in the window. `first_cp_index` is the lane's global index of

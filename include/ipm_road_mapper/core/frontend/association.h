@@ -69,13 +69,20 @@ struct MarkingCandidate {
   int class_id = 0;
   std::array<Eigen::Vector3d, 4> corners_map;
   Eigen::Matrix2d center_cov_map = Eigen::Matrix2d::Zero();  // Omega_p (x-y) in the map frame
+  bool complete = true;  // every side measured (not a partial view)
 };
+
+// Area of the intersection of two ground rectangles (x-y), over the smaller one's area.
+double OverlapOfSmaller(const std::array<Eigen::Vector3d, 4>& a,
+                        const std::array<Eigen::Vector3d, 4>& b);
 
 // Squared Mahalanobis distance of a candidate's center from an element's, in x-y.
 double MarkingAssociationCost(const MarkingElement& element, const MarkingCandidate& candidate,
                               const AssociationOptions& options);
 
-// For each candidate, the index of its marking element or -1 (new element).
+// For each candidate, the index of its marking element or -1 (new element). Where the
+// candidate or the element is a partial view, their centers need not agree: the pair is
+// also gated by overlap (at least association.marking_merge_overlap of the smaller one).
 std::vector<int> AssociateMarkings(const std::vector<MarkingElement>& elements,
                                    const std::vector<MarkingCandidate>& candidates,
                                    const AssociationOptions& options);

@@ -17,13 +17,13 @@ namespace ipm_road_mapper {
 struct ExtractionOptions {
   int min_marking_pixels = 150;        // smaller marking instances are dropped (tiny)
   int min_lane_pixels = 80;            // smaller lane instances are dropped (tiny)
-  int border_margin_px = 2;            // markings with a pixel this close to the border: truncated
+  int border_margin_px = 2;            // outline edges this close to the border are cut there
   int lane_row_step = 4;               // take a lane centerline point every this many rows
   int min_lane_points = 4;             // fewer valid centerline points: degenerate
   int max_instances_per_frame = 300;   // beyond this, the remaining instances are dropped
   double max_marking_range_m = 25.0;   // marking whose ground center is farther: dropped
   double min_rectangle_side_m = 0.05;  // thinner ground rectangles are degenerate
-  // A frame with more candidate instances than this (known class, not tiny, not truncated)
+  // A frame with more candidate instances than this (known class, not tiny)
   // is no real segmentation: its observations are dropped (the pose is still used).
   int max_plausible_instances = 100;
   // Same when the candidates' pixels cover more than this fraction of the pixels below
@@ -40,22 +40,24 @@ std::string ValidateMask(const cv::Mat& mask, int expected_width, int expected_h
 
 // Sets the marking's rectangle from its outline with sides along `axis_base` (the road's
 // direction in base_link, x-y): corners on the ground in canonical order, their pixels, the
-// center and its Omega_p. The minimum-area rectangle is no substitute: for an arrow it can
+// center and its Omega_p, and the sides' labels (measured or cut, from the outline's cut
+// edges; side_uv). The minimum-area rectangle is no substitute: for an arrow it can
 // lie along a slanted edge of the head, 0.3-0.4 m off at the corners and inconsistent from
 // frame to frame. False when a corner does not project.
 bool SetMarkingRectangle(const Ipm& ipm, const IpmErrorModel& error_model,
                          const Eigen::Vector2d& axis_base, MarkingObservation* marking);
 
 // Extracts every instance of `mask` (which must pass ValidateMask; an unusable mask gives
-// nothing). One scan groups the pixels by value; unknown classes, tiny instances and markings
-// within border_margin_px of the border are dropped from its statistics; when the rest are
-// more than max_plausible_instances or cover more than max_coverage of the pixels below the
-// horizon, the frame gives no observation (counted); otherwise the max_instances_per_frame
-// largest are processed. Markings: sub-pixel outline of the
-// significant 8-connected pieces (every glyph of a text; specks under a tenth of the largest
-// piece are left out) -> IPM (any outline point failing: dropped_range) -> the rectangle
-// along base_link's x axis (SetMarkingRectangle) -> canonical corners, projected back for
-// the pixel measurements; a rectangle (minimum-area, on the ground) longer or wider than the
+// nothing). One scan groups the pixels by value; unknown classes and tiny instances are
+// dropped from its statistics; when the rest are more than max_plausible_instances or cover
+// more than max_coverage of the pixels below the horizon, the frame gives no observation
+// (counted); otherwise the max_instances_per_frame largest are processed. Markings: sub-pixel
+// outline of the significant 8-connected pieces (every glyph of a text; specks under a tenth
+// of the largest piece are left out), its edges along the image border or next to another
+// instance labeled cut, clipped to where the IPM maps -> the rectangle along base_link's x
+// axis (SetMarkingRectangle) -> canonical corners, projected back for the pixel
+// measurements, each side labeled measured or cut (a partial view; every side cut:
+// dropped_border); a rectangle (minimum-area, on the ground) longer or wider than the
 // class's max_length_m / max_width_m is dropped (oversized).
 // Lanes: every lane_row_step rows from the bottom, the center column of each run of the
 // instance's pixels in that row -> IPM point + uncertainty score; a run wider on the ground

@@ -26,8 +26,9 @@ namespace ipm_road_mapper {
 // plane) and across it, returned in the order of reference_corners_map (best cyclic
 // match). The axis must come from outside the marking: any axis gives a rectangle that
 // every view agrees with, so the marking's own estimate would keep whatever orientation it
-// started with. False when an outline ray misses the plane (at or above its horizon), a
-// corner does not project, the axis is along the normal or the outline is empty.
+// started with. False when an outline ray misses the plane (at or above its horizon), the
+// axis is along the normal or the outline is empty. A corner behind the camera (the cut
+// corner of a partial view) is returned as NaN: callers use only the finite ones.
 bool MeasureCornersOnPlane(const PinholeCamera& camera, const Eigen::Isometry3d& T_map_cam,
                            const RoadPlane& plane, const Eigen::Vector3d& axis_map,
                            const std::array<Eigen::Vector3d, 4>& reference_corners_map,

@@ -24,9 +24,25 @@ struct MarkingObservation {
   // The same corners projected back into the image: the pixel measurements z_k.
   std::array<Eigen::Vector2d, 4> corners_uv;
   // The instance's convex outline in the image (sub-pixel) and on the ground (x-y in
-  // base_link, its IPM), what the rectangle is fitted to.
+  // base_link, its IPM), what the rectangle is fitted to. Where the IPM fails (beyond the
+  // range, at the horizon) the outline is clipped: only the part that maps is kept.
   std::vector<Eigen::Vector2d> outline_uv;
   std::vector<Eigen::Vector2d> outline_base;
+  // Per outline edge (vertex i to i + 1): 1 when it is no boundary of the marking but where
+  // the view ends (the image border, an adjacent occluder or instance, the range clip).
+  std::vector<std::uint8_t> outline_edge_cut;
+  // Per side of the rectangle (side i runs from corners_base[i] to corners_base[i + 1]):
+  // true when the marking's own boundary was seen there, false when the view cut it.
+  std::array<bool, 4> side_measured{{true, true, true, true}};
+  // Per measured side: pixels of the observed boundary on it (sampled outline points), the
+  // measurements of the edge residual (edge_reprojection_residual.h). Empty for cut sides.
+  std::array<std::vector<Eigen::Vector2d>, 4> side_uv;
+  // A corner is a measurement only where both of its sides are.
+  bool CornerMeasured(int i) const { return side_measured[(i + 3) % 4] && side_measured[i]; }
+  // Every side measured: the whole marking was in view.
+  bool Complete() const {
+    return side_measured[0] && side_measured[1] && side_measured[2] && side_measured[3];
+  }
   // Center of the rectangle (mean of corners_base) and the x-y block of Omega_p at its
   // pixel: how far plain IPM may have put it (m^2), for the association gate.
   Eigen::Vector3d center_base = Eigen::Vector3d::Zero();
@@ -55,7 +71,8 @@ struct ExtractionCounters {
   std::uint64_t instances_seen = 0;
   std::uint64_t dropped_unknown_class = 0;      // class id not in the class table
   std::uint64_t dropped_tiny = 0;               // fewer pixels than the class kind's minimum
-  std::uint64_t dropped_border = 0;             // marking touching the image border (truncated)
+  std::uint64_t dropped_border = 0;             // marking whose every side the view cuts
+  std::uint64_t partial_markings = 0;           // markings kept with some side cut (not a drop)
   std::uint64_t dropped_range = 0;              // beyond max range or above the horizon
   std::uint64_t dropped_degenerate = 0;         // too few valid lane points / flat rectangle
   std::uint64_t dropped_instance_limit = 0;     // more instances than max_instances_per_frame

@@ -29,6 +29,15 @@ struct MarkingMeasurement {
   // The instance's convex outline in the image: the back end re-measures the corners from
   // it on a better road plane than base_link's (MeasureCornersOnPlane).
   std::vector<Eigen::Vector2d> outline_uv;
+  // Partial views (MarkingObservation): which sides (side i from corner i to i + 1) the view
+  // measured, and the observed boundary pixels of each; a corner is a measurement only where
+  // both of its sides are.
+  std::array<bool, 4> side_measured{{true, true, true, true}};
+  std::array<std::vector<Eigen::Vector2d>, 4> side_uv;
+  bool CornerMeasured(int i) const { return side_measured[(i + 3) % 4] && side_measured[i]; }
+  bool Complete() const {
+    return side_measured[0] && side_measured[1] && side_measured[2] && side_measured[3];
+  }
 };
 
 // A mapped ground marking.
@@ -47,8 +56,26 @@ struct MarkingElement {
   double first_seen = 0.0, last_seen = 0.0;
   bool optimized = false;  // the back end owns the estimate from now on
   bool retired = false;    // left the window: its information is in the extrinsic prior
+  // Per side (side i from corner i to i + 1): some view saw the marking's boundary there.
+  // An unmeasured side is where the views ended so far: the extent grows past it as later
+  // views show more (a marking larger than the view), and the export says so.
+  std::array<bool, 4> side_measured{{true, true, true, true}};
+  // How many views measured each side (the running mean of its position).
+  std::array<std::size_t, 4> side_views{{0, 0, 0, 0}};
+  // Consistency with the road's motion (MarkingTracker::CheckConsistency): frames since
+  // creation in which it should have been visible (its center in the image, no farther
+  // than its farthest view) and those of them that saw it. A marking is confirmed once seen
+  // in at least half the frames it was expected in (and twice); until then it is tentative:
+  // not exported, not in the back end. A spurious blob is never seen again where it should.
+  std::size_t frames_expected = 0;
+  std::size_t frames_seen = 0;
+  double farthest_view_m = 0.0;  // largest ground distance of a view's center from base_link
+  bool confirmed = false;
   // Every observation ever made, pruned ones included.
   std::size_t Observations() const { return history.size() + pruned; }
+  bool Complete() const {
+    return side_measured[0] && side_measured[1] && side_measured[2] && side_measured[3];
+  }
   Eigen::Vector3d Center() const {
     return 0.25 * (corners_map[0] + corners_map[1] + corners_map[2] + corners_map[3]);
   }

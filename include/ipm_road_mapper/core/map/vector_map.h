@@ -30,6 +30,14 @@ struct MapMarking {
   int observations = 0;
   double first_seen = 0.0;  // stamps (s)
   double last_seen = 0.0;
+  // Per side (side i from corner i to i + 1): some view saw the marking's boundary there.
+  // An unmeasured side is where the views of a marking larger than the view ended: the
+  // rectangle is a lower bound of the marking in that direction.
+  std::array<bool, 4> sides_measured{{true, true, true, true}};
+  // Every side measured: a marking whose extent was closed (false: `complete: false`).
+  bool Complete() const {
+    return sides_measured[0] && sides_measured[1] && sides_measured[2] && sides_measured[3];
+  }
   Eigen::Vector3d Center() const {
     return 0.25 * (corners_map[0] + corners_map[1] + corners_map[2] + corners_map[3]);
   }

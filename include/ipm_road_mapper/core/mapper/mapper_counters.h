@@ -21,6 +21,7 @@ struct MapperCounters {
   std::uint64_t markings_created = 0;
   std::uint64_t lanes_created = 0;
   std::uint64_t spurious_dropped = 0;
+  std::uint64_t markings_inconsistent = 0;  // markings unseen where they should be: dropped
   std::uint64_t lanes_merged = 0;
   std::uint64_t markings_merged = 0;
   std::uint64_t lane_observations_unused = 0;  // unmatched and too short / unfit to start a lane

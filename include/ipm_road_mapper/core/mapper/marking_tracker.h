@@ -27,7 +27,8 @@ class MarkingTracker {
   void Update(const Ipm& ipm, const FrameRecord& frame,
               std::vector<MarkingObservation>* observations);
   // Drops the elements seen in one frame only and not again for
-  // association.spurious_after_frames frames.
+  // association.spurious_after_frames frames, and the tentative ones that frames where they
+  // should have been visible did not see (CheckConsistency).
   void DropSpurious(std::size_t frame_index);
 
  private:
@@ -37,6 +38,9 @@ class MarkingTracker {
   void OrientAlongRoad(const Ipm& ipm, const FrameRecord& frame,
                        std::vector<MarkingObservation>* observations);
   void Associate(const std::vector<MarkingObservation>& observations, const FrameRecord& frame);
+  // Counts, for each tentative live element, whether this frame should have seen it and
+  // whether it did; confirms the consistent ones.
+  void CheckConsistency(const Ipm& ipm, const FrameRecord& frame);
   // Merges elements of one class closer than association.marking_merge_distance_m or whose
   // rectangles overlap by association.marking_merge_overlap.
   void MergeDuplicates();

@@ -1,0 +1,75 @@
+// Tests of the extent of a marking seen in partial views (marking_extent.h).
+#include <gtest/gtest.h>
+
+#include "ipm_road_mapper/core/mapper/marking_extent.h"
+
+namespace ipm_road_mapper {
+namespace {
+
+// Rectangle [x0, x1] x [y0, y1], counter-clockwise from (x0, y0).
+std::array<Eigen::Vector3d, 4> Rect(double x0, double x1, double y0, double y1) {
+  return {Eigen::Vector3d(x0, y0, 0), Eigen::Vector3d(x1, y0, 0), Eigen::Vector3d(x1, y1, 0),
+          Eigen::Vector3d(x0, y1, 0)};
+}
+
+// An element 4 m along x and 10 m along y whose sides 0 and 2 (y = -5, y = +5) were
+// measured and whose sides 1 and 3 (x = 24, x = 20) were cut by the view.
+MarkingElement PartialCrossing() {
+  MarkingElement e;
+  e.corners_map = Rect(20.0, 24.0, -5.0, 5.0);
+  e.side_measured = {true, false, true, false};
+  e.side_views = {1, 0, 1, 0};
+  return e;
+}
+
+TEST(MarkingExtent, MeasuredSidesAreRunningMeansAndCutSidesDoNotShrink) {
+  MarkingElement e = PartialCrossing();
+  // A second view measuring sides 0 and 2 at y = -7 and y = 3, cut at x = 20 and 24 again.
+  UpdateExtent(Rect(20.0, 24.0, -7.0, 3.0), {true, false, true, false}, false, &e);
+  // The cut sides stay where they were (the view reaches no farther).
+  EXPECT_NEAR(e.corners_map[0].x(), 20.0, 1e-9);
+  EXPECT_NEAR(e.corners_map[1].x(), 24.0, 1e-9);
+  // Measured sides 0 (y = -5 vs -7) and 2 (y = 5 vs 3): running means of two views.
+  EXPECT_NEAR(e.corners_map[0].y(), -6.0, 1e-9);
+  EXPECT_NEAR(e.corners_map[2].y(), 4.0, 1e-9);
+  EXPECT_EQ(e.side_views[0], 2u);
+}
+
+TEST(MarkingExtent, UnmeasuredSideGrowsToTheFarthestViewAndTheFirstMeasurementSetsIt) {
+  MarkingElement e;
+  e.corners_map = Rect(0.0, 10.0, 0.0, 4.0);
+  e.side_measured = {true, false, true, true};  // side 1 (x = 10) not yet seen
+  e.side_views = {1, 0, 1, 1};
+  UpdateExtent(Rect(0.0, 14.0, 0.0, 4.0), {true, false, true, true}, false, &e);
+  EXPECT_NEAR(e.corners_map[1].x(), 14.0, 1e-9);  // grew with the cut view
+  UpdateExtent(Rect(0.0, 12.0, 0.0, 4.0), {true, false, true, true}, false, &e);
+  EXPECT_NEAR(e.corners_map[1].x(), 14.0, 1e-9);  // a shorter cut view never shrinks it
+  UpdateExtent(Rect(0.0, 16.0, 0.0, 4.0), {true, true, true, true}, false, &e);
+  EXPECT_NEAR(e.corners_map[1].x(), 16.0, 1e-9);  // the first measurement replaces the bound
+  EXPECT_NEAR(e.corners_map[2].x(), 16.0, 1e-9);
+  EXPECT_TRUE(e.side_measured[1]);
+  EXPECT_TRUE(e.Complete());
+}
+
+TEST(MarkingExtent, OwnedElementMovesOnlyUnmeasuredSides) {
+  MarkingElement e;
+  e.corners_map = Rect(0.0, 10.0, 0.0, 4.0);
+  e.side_measured = {true, false, true, true};
+  e.side_views = {1, 0, 1, 1};
+  UpdateExtent(Rect(1.0, 13.0, 0.5, 4.5), {true, false, true, true}, true, &e);
+  EXPECT_NEAR(e.corners_map[0].y(), 0.0, 1e-9);  // the back end owns measured sides
+  EXPECT_NEAR(e.corners_map[0].x(), 0.0, 1e-9);
+  EXPECT_NEAR(e.corners_map[1].x(), 13.0, 1e-9);  // the open end still grows
+}
+
+TEST(MarkingExtent, SideAlignedShiftPairsSidesOfASmallerView) {
+  const std::array<Eigen::Vector3d, 4> element = Rect(0.0, 20.0, 0.0, 4.0);
+  // The view's corners start at its top-right corner (shift 2 of the element's order).
+  const std::array<Eigen::Vector3d, 4> view = {Eigen::Vector3d(6, 4, 0), Eigen::Vector3d(2, 4, 0),
+                                               Eigen::Vector3d(2, 0, 0), Eigen::Vector3d(6, 0, 0)};
+  EXPECT_EQ(SideAlignedShift(element, view), 2);
+  EXPECT_EQ(SideAlignedShift(element, element), 0);
+}
+
+}  // namespace
+}  // namespace ipm_road_mapper
