@@ -134,6 +134,8 @@ TEST(SolveWindow, RecoversExtrinsicAndCornersWithExactPoses) {
   BackendOptions options = SyncOptions();
   options.pose_update = false;
   options.map_step_pose_sigma_scale = 0.0;  // the poses are exact here, and known to be
+  options.extrinsic_holdout_every_n_frames = 4;
+  options.extrinsic_hold_unobserved = true;
   const double before = MeanCornerError(SolveWindow(scene.snapshot,
                                                     [] {
                                                       BackendOptions o = SyncOptions();
@@ -179,6 +181,7 @@ TEST(SolveWindow, UnobservedLeverArmStaysAtItsStartValue) {
   BackendOptions options = SyncOptions();
   options.pose_update = false;
   options.map_step_pose_sigma_scale = 0.0;
+  options.extrinsic_hold_unobserved = true;
   const WindowResult r = SolveWindow(scene.snapshot, options);
   ASSERT_TRUE(r.usable) << r.reason;
   ASSERT_FALSE(r.extrinsic_observed[3]);

@@ -105,6 +105,7 @@ BackendOptions LoadBackendOptions(OptionsReader reader) {
   reader.Read<double>("max_extrinsic_change_m", &o.max_extrinsic_change_m, CheckPositive);
   reader.Read<double>("extrinsic_min_information_ratio", &o.extrinsic_min_information_ratio,
                       CheckNonNegative);
+  reader.Read<bool>("extrinsic_hold_unobserved", &o.extrinsic_hold_unobserved);
   reader.Read<double>(
       "extrinsic_prior_memory_markings", &o.extrinsic_prior_memory_markings, [](const double& v) {
         return v == 0.0 || (std::isfinite(v) && v >= 1.0) ? "" : "must be 0 or >= 1";
@@ -178,6 +179,7 @@ std::string ToString(const BackendOptions& o) {
     << k << "max_extrinsic_change_deg: " << o.max_extrinsic_change_rad / kDegToRad << "\n"
     << k << "max_extrinsic_change_m: " << o.max_extrinsic_change_m << "\n"
     << k << "extrinsic_min_information_ratio: " << o.extrinsic_min_information_ratio << "\n"
+    << k << "extrinsic_hold_unobserved: " << Bool(o.extrinsic_hold_unobserved) << "\n"
     << k << "extrinsic_prior_memory_markings: " << o.extrinsic_prior_memory_markings << "\n"
     << k << "extrinsic_holdout_every_n_frames: " << o.extrinsic_holdout_every_n_frames << "\n"
     << k << "extrinsic_holdout_sigmas: " << o.extrinsic_holdout_sigmas << "\n"

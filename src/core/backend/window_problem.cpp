@@ -346,8 +346,9 @@ constexpr double kUnobservedHoldWeight = 1e4;
 
 // The observability-aware update (extrinsic_observability.h): each direction the solve's
 // data does not observe (ObserveExtrinsic) is held at the window's starting extrinsic.
-void HoldUnobservedDirections(const WindowSnapshot& snapshot, const WindowState& state,
-                              ceres::Problem* problem) {
+void HoldUnobservedDirections(const WindowSnapshot& snapshot, const BackendOptions& options,
+                              const WindowState& state, ceres::Problem* problem) {
+  if (!options.extrinsic_hold_unobserved) return;
   if (!state.observability_valid || state.observability.rank == 6) return;
   const Eigen::Quaterniond q0 = Eigen::Quaterniond(snapshot.T_base_cam.linear()).normalized();
   problem->AddResidualBlock(
@@ -471,7 +472,7 @@ ceres::Solver::Summary MapStep(const WindowSnapshot& snapshot, const BackendOpti
       problem.SetParameterBlockConstant(q_bc);
       problem.SetParameterBlockConstant(t_bc);
     } else {
-      HoldUnobservedDirections(snapshot, *state, &problem);
+      HoldUnobservedDirections(snapshot, options, *state, &problem);
     }
   }
   return Solve(options, state->step_time_limit_s, &problem);

@@ -61,20 +61,24 @@ struct BackendOptions {
   Eigen::Vector3d pose_prior_sigma_rot_rad{0.001, 0.001, 0.0052};  // roll, pitch, yaw
   double max_extrinsic_change_rad = 2.0 * M_PI / 180.0;            // trust bound per solve
   double max_extrinsic_change_m = 0.2;
-  // Observability-aware extrinsic updates (extrinsic_observability.h): a direction of the
-  // extrinsic moves in a solve only when the solve's data knows it at least this many times
-  // better than the mounting prior (an eigenvalue of the prior-whitened information); the
-  // others are held at the solve's starting value.
+  // Observability of the extrinsic (extrinsic_observability.h): a direction is observed
+  // when the solve's data knows it at least this many times better than the mounting prior
+  // (an eigenvalue of the prior-whitened information). It decides the calibration's
+  // observed flags and covariance, and, with extrinsic_hold_unobserved, the update: each
+  // unobserved direction is held at the solve's starting value (off by default: on the
+  // benchmark drives it stops the x/y lever arm wandering but costs rotation accuracy on
+  // hilly, port and av2_pit_dev; docs/backend.md).
   double extrinsic_min_information_ratio = 4.0;
+  bool extrinsic_hold_unobserved = false;
   // Memory of the retired markings' information in the extrinsic prior, in markings: each
   // retiring marking scales what is there by 1 - 1 / N (extrinsic_prior.h); 0: a plain sum.
-  double extrinsic_prior_memory_markings = 50.0;
+  double extrinsic_prior_memory_markings = 0.0;
   // The guard against harm: every N-th frame's measurements are left out of the first map
   // step, and a refined extrinsic that explains them worse than the previous one (with the
   // map re-fit to each) by more than extrinsic_holdout_sigmas times the spread of the
   // per-measurement differences is refused: the previous one stays. N = 0: off. Sigmas 0:
   // only an extrinsic that explains them at least as well is kept.
-  int extrinsic_holdout_every_n_frames = 4;
+  int extrinsic_holdout_every_n_frames = 0;
   double extrinsic_holdout_sigmas = 2.0;
   int max_lane_points_per_observation = 6;  // PPSR/PSR pixels per lane observation
   // A lane pixel whose IPM point is farther than this from its spline is not used.
