@@ -205,6 +205,37 @@ void LaneTracker::MergeLines() {
       ++counters_->lanes_merged;
     }
   }
+  JoinFragments();
+}
+
+void LaneTracker::JoinFragments() {
+  const LaneJoinOptions& join = options_.lanes.join;
+  // Ends farther apart than this cannot be joined (a cheap test before the models).
+  const double reach_m = join.max_gap_m + join.max_overlap_m + 2.0 * join.end_length_m;
+  std::vector<LaneElement>& lanes = store_->lanes();
+  bool joined = true;
+  while (joined) {
+    joined = false;
+    for (std::size_t a = 0; a < lanes.size() && !joined; ++a) {
+      for (std::size_t b = 0; b < lanes.size() && !joined; ++b) {
+        if (a == b || lanes[a].class_id != lanes[b].class_id) continue;
+        const auto& ca = lanes[a].control_points_map;
+        const auto& cb = lanes[b].control_points_map;
+        if (ca.size() < 4 || cb.size() < 4 ||
+            (ca[ca.size() - 2] - cb[1]).head<2>().norm() > reach_m) {
+          continue;
+        }
+        if (!LaneContinues(lanes[a], lanes[b], join, options_.association)) continue;
+        auto result = JoinLanes(lanes[a], lanes[b], join, options_.association,
+                                options_.lanes.fit.chord_spacing_m);
+        if (!result) continue;
+        lanes[a] = std::move(*result);
+        lanes.erase(lanes.begin() + b);
+        ++counters_->lanes_joined;
+        joined = true;
+      }
+    }
+  }
 }
 
 void LaneTracker::DropSpurious(std::size_t frame_index) {

@@ -116,7 +116,11 @@ void Mapper::Reset() {
   last_stamp_ = -1.0;
 }
 
-bool Mapper::Finish(double time_budget_s) { return windows_.Finish(time_budget_s); }
+bool Mapper::Finish(double time_budget_s) {
+  const bool finished = windows_.Finish(time_budget_s);
+  lanes_.JoinFragments();  // fragments the drive's last frames left apart
+  return finished;
+}
 
 VectorMap Mapper::ExportMap(const ExportOptions& export_options) const {
   VectorMap out;

@@ -28,6 +28,9 @@ class LaneTracker {
   // Drops the lanes seen in one frame only and not again for
   // association.spurious_after_frames frames.
   void DropSpurious(std::size_t frame_index);
+  // Joins the lanes that continue one another (LaneContinues), until none does; runs with
+  // the merge and at the end of the drive.
+  void JoinFragments();
 
   // The lane's control points re-fit to all its selected pixels, IPMed with `T_base_cam`
   // and the frames' current poses (export of lanes no lane residual refines).
