@@ -94,9 +94,17 @@ int ExtendEnd(const LaneEndFitOptions& options, const std::vector<Eigen::Vector3
   if (add <= 0) return 0;
   const Eigen::Vector2d offset = FitEndOffset(along_lateral, kappa, options.robust_scale_m);
   cps->pop_back();  // the old phantom
+  // On the circle of the fit's direction and curvature at the end (the parabola is its
+  // approximation near the end; the circle keeps the chord spacing along an arc).
+  const double heading = std::atan(offset.x()), curvature = 2.0 * offset.y();
   for (int k = 1; k <= add; ++k) {
     const double s = k * options.chord_spacing_m;
-    cps->push_back(end + s * tangent + (offset.x() * s + offset.y() * s * s) * normal);
+    double x = s * std::cos(heading), y = s * std::sin(heading);
+    if (std::abs(curvature) > 1e-6) {
+      x = (std::sin(heading + curvature * s) - std::sin(heading)) / curvature;
+      y = (std::cos(heading) - std::cos(heading + curvature * s)) / curvature;
+    }
+    cps->push_back(end + x * tangent + y * normal);
   }
   cps->push_back(2.0 * cps->back() - (*cps)[cps->size() - 2]);
   return add;

@@ -11,7 +11,8 @@ namespace {
 // Each end is modelled by at most this many observations (the latest at an end, the
 // earliest at a start): the ones that shaped it.
 constexpr std::size_t kMaxEndObservations = 60;
-// Curvature prior of an end model: c = kappa / 2 with kappa within 0.02 1/m (R 50 m) of 0.
+// Curvature prior of an end model: c = kappa / 2, kappa within this (1/m) of the curvature
+// of the lane's own control points there.
 constexpr double kCurvatureSigma = 0.01;
 // The two ends must point within this angle of each other before they are compared.
 constexpr double kMinDirectionCos = 0.87;  // 30 deg
@@ -35,6 +36,7 @@ struct EndModel {
   Eigen::Matrix3d cov = Eigen::Matrix3d::Identity();
   double x_min = 0.0, x_max = 0.0;  // extent of its data along the frame
   double Offset(double x) const { return coeff.dot(Eigen::Vector3d(1.0, x, x * x)); }
+  double Slope(double x) const { return coeff.y() + 2.0 * coeff.z() * x; }
 };
 
 // Horizontal direction of a lane at its end (at_end) or start, over about `length_m`.
@@ -51,6 +53,25 @@ Eigen::Vector2d EndDirection(const std::vector<Eigen::Vector3d>& cps, bool at_en
   Eigen::Vector2d d =
       at_end ? (cps[end] - cps[other]).head<2>().eval() : (cps[other] - cps[end]).head<2>().eval();
   return d.norm() > 1e-9 ? d.normalized() : Eigen::Vector2d::Zero();
+}
+
+// Signed curvature (1/m, > 0 left) of a lane near its end (at_end) or start: the turn of
+// its direction over about `length_m`, over that length.
+double EndCurvature(const std::vector<Eigen::Vector3d>& cps, bool at_end, double length_m) {
+  const int n = static_cast<int>(cps.size());
+  if (n < 5) return 0.0;
+  const int end = at_end ? n - 2 : 1, step = at_end ? -1 : 1;
+  int mid = end, far = end;
+  double travelled = 0.0;
+  while (far + step >= 1 && far + step <= n - 2 && travelled < length_m) {
+    travelled += (cps[far + step] - cps[far]).head<2>().norm();
+    far += step;
+    if (travelled < 0.5 * length_m) mid = far;
+  }
+  if (mid == end || mid == far || travelled < 1e-6) return 0.0;
+  const Eigen::Vector2d u = (cps[mid] - cps[far]).head<2>(), v = (cps[end] - cps[mid]).head<2>();
+  const double turn = std::atan2(u.x() * v.y() - u.y() * v.x(), u.dot(v));
+  return (at_end ? turn : -turn) / (0.5 * travelled);  // walked backwards from a start
 }
 
 // The data near one end of `lane` in `frame`, each observation weighted once in total: the
@@ -108,7 +129,7 @@ void EndData(const LaneElement& lane, bool at_end, const PairFrame& frame, doubl
 // Huber rounds (scale 2 sigma) so that one stray observation does not bend the end.
 std::optional<EndModel> FitEndModel(const std::vector<Eigen::Vector3d>& points,
                                     const std::vector<double>& weights, const PairFrame& frame,
-                                    double sigma_m) {
+                                    double kappa, double sigma_m) {
   if (points.size() < 2) return std::nullopt;
   EndModel model;
   model.x_min = std::numeric_limits<double>::infinity();
@@ -130,7 +151,9 @@ std::optional<EndModel> FitEndModel(const std::vector<Eigen::Vector3d>& points,
       N += w * row * row.transpose();
       b += w * row * xy[i].y();
     }
-    N(2, 2) += 1.0 / std::pow(0.5 * kCurvatureSigma, 2);
+    const double curvature_weight = 1.0 / std::pow(0.5 * kCurvatureSigma, 2);
+    N(2, 2) += curvature_weight;
+    b(2) += curvature_weight * 0.5 * kappa;
     N(0, 0) += 1e-9;
     N(1, 1) += 1e-9;
     model.coeff = N.ldlt().solve(b);
@@ -160,9 +183,9 @@ std::optional<PairAnalysis> Analyze(const LaneElement& first, const LaneElement&
       second.control_points_map.size() < 4) {
     return std::nullopt;
   }
-  const Eigen::Vector2d t_first = EndDirection(first.control_points_map, true, join.end_length_m);
-  const Eigen::Vector2d t_second =
-      EndDirection(second.control_points_map, false, join.end_length_m);
+  // The directions at the very ends (a chord): over longer stretches an arc turns too much.
+  const Eigen::Vector2d t_first = EndDirection(first.control_points_map, true, 0.0);
+  const Eigen::Vector2d t_second = EndDirection(second.control_points_map, false, 0.0);
   if (t_first.dot(t_second) < kMinDirectionCos) return std::nullopt;
   PairAnalysis a;
   a.frame.origin = first.control_points_map[first.control_points_map.size() - 2].head<2>();
@@ -172,8 +195,12 @@ std::optional<PairAnalysis> Analyze(const LaneElement& first, const LaneElement&
   std::vector<double> weights_first, weights_second;
   EndData(first, true, a.frame, join.end_length_m, &points_first, &weights_first);
   EndData(second, false, a.frame, join.end_length_m, &points_second, &weights_second);
-  const auto model_first = FitEndModel(points_first, weights_first, a.frame, sigma);
-  const auto model_second = FitEndModel(points_second, weights_second, a.frame, sigma);
+  const auto model_first =
+      FitEndModel(points_first, weights_first, a.frame,
+                  EndCurvature(first.control_points_map, true, join.end_length_m), sigma);
+  const auto model_second =
+      FitEndModel(points_second, weights_second, a.frame,
+                  EndCurvature(second.control_points_map, false, join.end_length_m), sigma);
   if (!model_first || !model_second) return std::nullopt;
   a.first = *model_first;
   a.second = *model_second;
@@ -238,16 +265,21 @@ std::optional<LaneElement> JoinLanes(const LaneElement& first, const LaneElement
     if (a->frame.Local(cs[j]).x() >= x_second_start) tail.push_back(cs[j]);
   }
   if (cps.size() < 2 || tail.empty()) return std::nullopt;
-  // The bridge: on the blend of the two end models, z linear between its ends.
+  // The bridge: a cubic (Hermite) from first's last kept control point to second's first,
+  // with the end models' directions there; z linear between them.
   const Eigen::Vector3d from = cps.back(), to = tail.front();
-  const double xa = a->frame.Local(from).x(), xb = a->frame.Local(to).x();
-  const int inserted = std::max(0, static_cast<int>(std::lround((xb - xa) / chord_spacing_m)) - 1);
+  const Eigen::Vector2d la = a->frame.Local(from), lb = a->frame.Local(to);
+  const double length = lb.x() - la.x();
+  const int inserted =
+      length > 0.0 ? std::max(0, static_cast<int>(std::lround(length / chord_spacing_m)) - 1) : 0;
+  const double slope_a = a->first.Slope(la.x()), slope_b = a->second.Slope(lb.x());
   for (int k = 1; k <= inserted; ++k) {
-    const double w = static_cast<double>(k) / (inserted + 1);
-    const double x = xa + w * (xb - xa);
-    const double y = (1.0 - w) * a->first.Offset(x) + w * a->second.Offset(x);
-    const Eigen::Vector2d p = a->frame.Map(x, y);
-    cps.emplace_back(p.x(), p.y(), (1.0 - w) * from.z() + w * to.z());
+    const double t = static_cast<double>(k) / (inserted + 1);
+    const double h00 = 2 * t * t * t - 3 * t * t + 1, h10 = t * t * t - 2 * t * t + t;
+    const double h01 = -2 * t * t * t + 3 * t * t, h11 = t * t * t - t * t;
+    const double y = h00 * la.y() + h10 * length * slope_a + h01 * lb.y() + h11 * length * slope_b;
+    const Eigen::Vector2d p = a->frame.Map(la.x() + t * length, y);
+    cps.emplace_back(p.x(), p.y(), (1.0 - t) * from.z() + t * to.z());
   }
   cps.insert(cps.end(), tail.begin(), tail.end());
   cps.push_back(2.0 * cps.back() - cps[cps.size() - 2]);
