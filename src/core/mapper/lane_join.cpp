@@ -5,6 +5,8 @@
 #include <cmath>
 #include <limits>
 
+#include "ipm_road_mapper/core/geometry/catmull_rom_spline.h"
+
 namespace ipm_road_mapper {
 namespace {
 
@@ -53,25 +55,6 @@ Eigen::Vector2d EndDirection(const std::vector<Eigen::Vector3d>& cps, bool at_en
   Eigen::Vector2d d =
       at_end ? (cps[end] - cps[other]).head<2>().eval() : (cps[other] - cps[end]).head<2>().eval();
   return d.norm() > 1e-9 ? d.normalized() : Eigen::Vector2d::Zero();
-}
-
-// Signed curvature (1/m, > 0 left) of a lane near its end (at_end) or start: the turn of
-// its direction over about `length_m`, over that length.
-double EndCurvature(const std::vector<Eigen::Vector3d>& cps, bool at_end, double length_m) {
-  const int n = static_cast<int>(cps.size());
-  if (n < 5) return 0.0;
-  const int end = at_end ? n - 2 : 1, step = at_end ? -1 : 1;
-  int mid = end, far = end;
-  double travelled = 0.0;
-  while (far + step >= 1 && far + step <= n - 2 && travelled < length_m) {
-    travelled += (cps[far + step] - cps[far]).head<2>().norm();
-    far += step;
-    if (travelled < 0.5 * length_m) mid = far;
-  }
-  if (mid == end || mid == far || travelled < 1e-6) return 0.0;
-  const Eigen::Vector2d u = (cps[mid] - cps[far]).head<2>(), v = (cps[end] - cps[mid]).head<2>();
-  const double turn = std::atan2(u.x() * v.y() - u.y() * v.x(), u.dot(v));
-  return (at_end ? turn : -turn) / (0.5 * travelled);  // walked backwards from a start
 }
 
 // The data near one end of `lane` in `frame`, each observation weighted once in total: the
@@ -197,10 +180,10 @@ std::optional<PairAnalysis> Analyze(const LaneElement& first, const LaneElement&
   EndData(second, false, a.frame, join.end_length_m, &points_second, &weights_second);
   const auto model_first =
       FitEndModel(points_first, weights_first, a.frame,
-                  EndCurvature(first.control_points_map, true, join.end_length_m), sigma);
+                  LaneEndCurvature(first.control_points_map, true, join.end_length_m), sigma);
   const auto model_second =
       FitEndModel(points_second, weights_second, a.frame,
-                  EndCurvature(second.control_points_map, false, join.end_length_m), sigma);
+                  LaneEndCurvature(second.control_points_map, false, join.end_length_m), sigma);
   if (!model_first || !model_second) return std::nullopt;
   a.first = *model_first;
   a.second = *model_second;
@@ -232,9 +215,14 @@ bool CoObserved(const LaneElement& a, const LaneElement& b) {
 
 bool LaneContinues(const LaneElement& first, const LaneElement& second, const LaneJoinOptions& join,
                    const AssociationOptions& options) {
-  if (CoObserved(first, second)) return false;
+  return LaneJoinCost(first, second, join, options) >= 0.0;
+}
+
+double LaneJoinCost(const LaneElement& first, const LaneElement& second,
+                    const LaneJoinOptions& join, const AssociationOptions& options) {
+  if (CoObserved(first, second)) return -1.0;
   const auto a = Analyze(first, second, join, options);
-  if (!a) return false;
+  if (!a) return -1.0;
   const double x = a->x_meet;
   const Eigen::Vector3d J(1.0, x, x * x), dJ(0.0, 1.0, 2.0 * x);
   const double offset = a->first.Offset(x) - a->second.Offset(x);
@@ -243,8 +231,9 @@ bool LaneContinues(const LaneElement& first, const LaneElement& second, const La
   const double var_offset = J.dot(a->first.cov * J) + J.dot(a->second.cov * J) + 2.0 * floor2;
   const double var_slope = dJ.dot(a->first.cov * dJ) + dJ.dot(a->second.cov * dJ) +
                            2.0 * floor2 / (join.end_length_m * join.end_length_m);
-  return std::abs(offset) <= join.gate_sigmas * std::sqrt(var_offset) &&
-         std::abs(slope) <= join.gate_sigmas * std::sqrt(var_slope);
+  const double cost =
+      std::max(std::abs(offset) / std::sqrt(var_offset), std::abs(slope) / std::sqrt(var_slope));
+  return cost <= join.gate_sigmas ? cost : -1.0;
 }
 
 std::optional<LaneElement> JoinLanes(const LaneElement& first, const LaneElement& second,

@@ -224,11 +224,12 @@ void LaneTracker::JoinFragments() {
   // Ends farther apart than this cannot be joined (a cheap test before the models).
   const double reach_m = join.max_gap_m + join.max_overlap_m + 2.0 * join.end_length_m;
   std::vector<LaneElement>& lanes = store_->lanes();
-  bool joined = true;
-  while (joined) {
-    joined = false;
-    for (std::size_t a = 0; a < lanes.size() && !joined; ++a) {
-      for (std::size_t b = 0; b < lanes.size() && !joined; ++b) {
+  // The best pair first, until none passes: each end continues into at most one lane.
+  while (true) {
+    double best_cost = -1.0;
+    std::size_t best_a = 0, best_b = 0;
+    for (std::size_t a = 0; a < lanes.size(); ++a) {
+      for (std::size_t b = 0; b < lanes.size(); ++b) {
         if (a == b || lanes[a].class_id != lanes[b].class_id) continue;
         const auto& ca = lanes[a].control_points_map;
         const auto& cb = lanes[b].control_points_map;
@@ -236,16 +237,21 @@ void LaneTracker::JoinFragments() {
             (ca[ca.size() - 2] - cb[1]).head<2>().norm() > reach_m) {
           continue;
         }
-        if (!LaneContinues(lanes[a], lanes[b], join, options_.association)) continue;
-        auto result = JoinLanes(lanes[a], lanes[b], join, options_.association,
-                                options_.lanes.fit.chord_spacing_m);
-        if (!result) continue;
-        lanes[a] = std::move(*result);
-        lanes.erase(lanes.begin() + b);
-        ++counters_->lanes_joined;
-        joined = true;
+        const double cost = LaneJoinCost(lanes[a], lanes[b], join, options_.association);
+        if (cost >= 0.0 && (best_cost < 0.0 || cost < best_cost)) {
+          best_cost = cost;
+          best_a = a;
+          best_b = b;
+        }
       }
     }
+    if (best_cost < 0.0) return;
+    auto result = JoinLanes(lanes[best_a], lanes[best_b], join, options_.association,
+                            options_.lanes.fit.chord_spacing_m);
+    if (!result) return;  // degenerate: left apart (rare; the next merge tries again)
+    lanes[best_a] = std::move(*result);
+    lanes.erase(lanes.begin() + best_b);
+    ++counters_->lanes_joined;
   }
 }
 

@@ -29,6 +29,12 @@ struct LaneJoinOptions {
 // give the per-frame noise floor.
 bool LaneContinues(const LaneElement& first, const LaneElement& second, const LaneJoinOptions& join,
                    const AssociationOptions& options);
+// The same test as a cost: the larger of the offset's and the direction's disagreement in
+// combined sigmas (<= gate_sigmas), or -1 when `second` does not continue `first`. Of
+// several candidates the lowest cost is the continuation (at 0.5 m of odometry noise the
+// next lane's line 3.5 m beside can pass the gate too).
+double LaneJoinCost(const LaneElement& first, const LaneElement& second,
+                    const LaneJoinOptions& join, const AssociationOptions& options);
 
 // `first` and `second` joined into one lane (first's id and control-point indices at its
 // start): first's control points up to its last data, a bridge over the gap on the blend of
