@@ -23,48 +23,14 @@ Eigen::Vector4d Basis(double u) {
                                u + 4.0 * u2 - 3.0 * u3, -u2 + u3);
 }
 
-// Signed curvature (1/m, > 0 turning left) of the curve through a, b, c in x-y: the turn
-// angle between the two chords over their mean length.
-double SignedCurvature(const Eigen::Vector3d& a, const Eigen::Vector3d& b,
-                       const Eigen::Vector3d& c) {
-  const Eigen::Vector2d u = (b - a).head<2>(), v = (c - b).head<2>();
-  const double length = 0.5 * (u.norm() + v.norm());
-  if (length < 1e-9) return 0.0;
-  return std::atan2(u.x() * v.y() - u.y() * v.x(), u.dot(v)) / length;
-}
-
-// The lateral offset d(s) = b s + c s^2 (d across the end tangent, s along it) of the points
-// beyond an end, by robust least squares with priors b ~ 0 (the end's direction) and
-// c ~ kappa / 2 (the end's curvature): the new control points follow the data, and where
-// the data are thin, the curve's own bend rather than a straight line.
-Eigen::Vector2d FitEndOffset(const std::vector<Eigen::Vector2d>& along_lateral, double kappa,
-                             double robust_scale_m) {
-  const double slope_sigma = 0.05;      // rad: how far the end's direction may be off
-  const double curvature_sigma = 0.01;  // 1/m: how far its bend may be off (R 100 m)
-  Eigen::Vector2d x(0.0, 0.5 * kappa);
-  for (int round = 0; round < kReweightRounds; ++round) {
-    Eigen::Matrix2d A = Eigen::Matrix2d::Zero();
-    Eigen::Vector2d b = Eigen::Vector2d::Zero();
-    A(0, 0) += 1.0 / (slope_sigma * slope_sigma);
-    const double wc = 1.0 / std::pow(0.5 * curvature_sigma, 2);
-    A(1, 1) += wc;
-    b(1) += wc * 0.5 * kappa;
-    for (const Eigen::Vector2d& q : along_lateral) {
-      const Eigen::Vector2d row(q.x(), q.x() * q.x());
-      const double r = std::abs(row.dot(x) - q.y());
-      const double w = r <= robust_scale_m ? 1.0 : robust_scale_m / r;
-      A += w * row * row.transpose();
-      b += w * row * q.y();
-    }
-    x = A.ldlt().solve(b);
-  }
-  return x;
-}
+// The baseline of an end's curvature (LaneEndCurvature) and its bound (R 20 m).
+constexpr double kEndCurvatureLengthM = 15.0;
+constexpr double kMaxEndCurvature = 0.05;
 
 // Appends control points at the end of `cps` (phantom last) for the points beyond it: the
-// points within max_point_distance_m of the end's curve extrapolated along its curvature,
-// the new control points every chord spacing on the curve fitted to them (FitEndOffset).
-// Returns how many were added.
+// points within max_point_distance_m of the end's circle (its tangent and its curvature over
+// kEndCurvatureLengthM), the new control points every chord spacing on that circle (the fit
+// of step 2 then moves them to the data). Returns how many were added.
 int ExtendEnd(const LaneEndFitOptions& options, const std::vector<Eigen::Vector3d>& points,
               std::vector<Eigen::Vector3d>* cps) {
   const std::size_t n = cps->size();
@@ -74,17 +40,26 @@ int ExtendEnd(const LaneEndFitOptions& options, const std::vector<Eigen::Vector3
   tangent.normalize();
   const Eigen::Vector3d normal =
       Eigen::Vector3d(-tangent.y(), tangent.x(), 0.0).normalized();  // left, horizontal
-  const double kappa = n >= 5 ? SignedCurvature((*cps)[n - 4], (*cps)[n - 3], end) : 0.0;
+  const double curvature = std::clamp(LaneEndCurvature(*cps, true, kEndCurvatureLengthM),
+                                      -kMaxEndCurvature, kMaxEndCurvature);
+  // The circle's point at arc length s (straight ahead when it is flat).
+  auto on_circle = [&](double s) {
+    if (std::abs(curvature) < 1e-6) return Eigen::Vector2d(s, 0.0);
+    return Eigen::Vector2d(std::sin(curvature * s) / curvature,
+                           (1.0 - std::cos(curvature * s)) / curvature);
+  };
   std::vector<double> beyond;
-  std::vector<Eigen::Vector2d> along_lateral;
   for (const Eigen::Vector3d& p : points) {
     const Eigen::Vector3d d = p - end;
     const double along = d.dot(tangent);
     if (along <= 0.0) continue;
-    const double lateral = d.dot(normal);
-    if (std::abs(lateral - 0.5 * kappa * along * along) > options.max_point_distance_m) continue;
+    // Lateral distance from the circle: its offset at this along (|curvature * along| < 1).
+    const double ka = curvature * along;
+    if (std::abs(ka) >= 1.0) continue;
+    const double predicted =
+        std::abs(curvature) < 1e-6 ? 0.0 : (1.0 - std::sqrt(1.0 - ka * ka)) / curvature;
+    if (std::abs(d.dot(normal) - predicted) > options.max_point_distance_m) continue;
     beyond.push_back(along);
-    along_lateral.emplace_back(along, lateral);
   }
   if (static_cast<int>(beyond.size()) < options.min_points_to_extend) return 0;
   // The second-farthest point: one stray sample does not stretch the lane.
@@ -92,19 +67,10 @@ int ExtendEnd(const LaneEndFitOptions& options, const std::vector<Eigen::Vector3
   const double reach = beyond[beyond.size() - 2];
   const int add = static_cast<int>(std::floor(reach / options.chord_spacing_m + 0.5));
   if (add <= 0) return 0;
-  const Eigen::Vector2d offset = FitEndOffset(along_lateral, kappa, options.robust_scale_m);
   cps->pop_back();  // the old phantom
-  // On the circle of the fit's direction and curvature at the end (the parabola is its
-  // approximation near the end; the circle keeps the chord spacing along an arc).
-  const double heading = std::atan(offset.x()), curvature = 2.0 * offset.y();
   for (int k = 1; k <= add; ++k) {
-    const double s = k * options.chord_spacing_m;
-    double x = s * std::cos(heading), y = s * std::sin(heading);
-    if (std::abs(curvature) > 1e-6) {
-      x = (std::sin(heading + curvature * s) - std::sin(heading)) / curvature;
-      y = (std::cos(heading) - std::cos(heading + curvature * s)) / curvature;
-    }
-    cps->push_back(end + x * tangent + y * normal);
+    const Eigen::Vector2d q = on_circle(k * options.chord_spacing_m);
+    cps->push_back(end + q.x() * tangent + q.y() * normal);
   }
   cps->push_back(2.0 * cps->back() - (*cps)[cps->size() - 2]);
   return add;

@@ -45,7 +45,22 @@ nlohmann::json LaneToJson(const MapLane& lane) {
           {"control_points", points},
           {"observations", lane.observations},
           {"first_seen", lane.first_seen},
-          {"last_seen", lane.last_seen}};
+          {"last_seen", lane.last_seen},
+          {"predecessors", lane.predecessors},
+          {"successors", lane.successors}};
+}
+
+// An optional array of lane ids (`predecessors`, `successors`); empty when absent.
+std::vector<std::uint64_t> OptionalIds(const nlohmann::json& j, const char* key,
+                                       const std::string& where) {
+  std::vector<std::uint64_t> ids;
+  if (!j.contains(key)) return ids;
+  const std::string ids_where = Key(where, key);
+  const nlohmann::json& array = json_io::ReadArray(j.at(key), ids_where);
+  for (std::size_t k = 0; k < array.size(); ++k) {
+    ids.push_back(json_io::ReadUint64(array[k], Index(ids_where, k)));
+  }
+  return ids;
 }
 
 MapMarking MarkingFromJson(const nlohmann::json& j, const std::string& where) {
@@ -86,6 +101,8 @@ MapLane LaneFromJson(const nlohmann::json& j, const std::string& where) {
   lane.observations = json_io::OptionalInt(j, "observations", 0, where);
   lane.first_seen = json_io::OptionalNumber(j, "first_seen", 0.0, where);
   lane.last_seen = json_io::OptionalNumber(j, "last_seen", 0.0, where);
+  lane.predecessors = OptionalIds(j, "predecessors", where);
+  lane.successors = OptionalIds(j, "successors", where);
   return lane;
 }
 
@@ -182,6 +199,18 @@ VectorMap VectorMapFromJson(const nlohmann::json& j) {
     }
     if (!lane_ids.insert(map.lanes.back().id).second) {
       Fail(Index("lanes", i), "duplicate id " + std::to_string(map.lanes.back().id));
+    }
+  }
+  // Topology refers to lanes of this map, never to the lane itself.
+  for (std::size_t i = 0; i < map.lanes.size(); ++i) {
+    const MapLane& lane = map.lanes[i];
+    for (const auto* ids : {&lane.predecessors, &lane.successors}) {
+      for (const std::uint64_t id : *ids) {
+        if (id == lane.id || lane_ids.count(id) == 0) {
+          Fail(Index("lanes", i), "topology names lane " + std::to_string(id) +
+                                      ", which is not another lane of the map");
+        }
+      }
     }
   }
   if (j.contains("trajectory")) {

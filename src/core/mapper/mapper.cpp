@@ -6,6 +6,7 @@
 
 #include "ipm_road_mapper/core/frontend/instance_extraction.h"
 #include "ipm_road_mapper/core/geometry/ipm.h"
+#include "ipm_road_mapper/core/mapper/lane_topology.h"
 #include "ipm_road_mapper/core/mapper/timing_series.h"
 
 namespace ipm_road_mapper {
@@ -166,6 +167,7 @@ VectorMap Mapper::ExportMap(const ExportOptions& export_options) const {
     lane.last_seen = element.last_seen;
     out.lanes.push_back(std::move(lane));
   }
+  LinkLaneTopology(&out.lanes);
   const std::vector<FrameRecord>& frames = store_.frames();
   const std::size_t max_poses = export_options.max_trajectory_poses;
   const std::size_t first =
