@@ -1,6 +1,6 @@
 // Lane topology (lane_topology.h) and its map-file round trip: a line that goes on in
-// another class and a fork's branch are linked; a double line's halves, lanes far apart and
-// a file naming a lane it does not hold are not.
+// another class and a fork's branch are linked; a double line's halves and lanes far apart
+// are not; a file whose lane names itself is refused.
 #include <gtest/gtest.h>
 
 #include <cmath>
@@ -76,8 +76,11 @@ TEST(LaneTopology, RoundTripsThroughTheMapFile) {
   nlohmann::json j = VectorMapToJson(map);
   j["lanes"][0].erase("successors");
   EXPECT_TRUE(VectorMapFromJson(j).lanes[0].successors.empty());
-  // ... and one naming a lane it does not hold is refused.
-  j["lanes"][0]["successors"] = {7};
+  // ... one naming a lane outside it (a part of a cut map) keeps the link, and one naming
+  // the lane itself is refused.
+  j["lanes"][0]["successors"] = nlohmann::json::array({7u});
+  EXPECT_EQ(VectorMapFromJson(j).lanes[0].successors, std::vector<std::uint64_t>{7});
+  j["lanes"][0]["successors"] = nlohmann::json::array({1u});
   EXPECT_THROW(VectorMapFromJson(j), MapFormatError);
 }
 
