@@ -42,22 +42,24 @@ int ExtendEnd(const LaneEndFitOptions& options, const std::vector<Eigen::Vector3
       Eigen::Vector3d(-tangent.y(), tangent.x(), 0.0).normalized();  // left, horizontal
   const double curvature = std::clamp(LaneEndCurvature(*cps, true, kEndCurvatureLengthM),
                                       -kMaxEndCurvature, kMaxEndCurvature);
+  // The last chord runs along the curve's direction half a chord back: the end's own
+  // direction is turned by half the chord's bend.
+  const double heading = 0.5 * curvature * (end - (*cps)[n - 3]).head<2>().norm();
   // The circle's point at arc length s (straight ahead when it is flat).
   auto on_circle = [&](double s) {
-    if (std::abs(curvature) < 1e-6) return Eigen::Vector2d(s, 0.0);
-    return Eigen::Vector2d(std::sin(curvature * s) / curvature,
-                           (1.0 - std::cos(curvature * s)) / curvature);
+    if (std::abs(curvature) < 1e-6) {
+      return Eigen::Vector2d(s * std::cos(heading), s * std::sin(heading));
+    }
+    return Eigen::Vector2d((std::sin(heading + curvature * s) - std::sin(heading)) / curvature,
+                           (std::cos(heading) - std::cos(heading + curvature * s)) / curvature);
   };
   std::vector<double> beyond;
   for (const Eigen::Vector3d& p : points) {
     const Eigen::Vector3d d = p - end;
     const double along = d.dot(tangent);
     if (along <= 0.0) continue;
-    // Lateral distance from the circle: its offset at this along (|curvature * along| < 1).
-    const double ka = curvature * along;
-    if (std::abs(ka) >= 1.0) continue;
-    const double predicted =
-        std::abs(curvature) < 1e-6 ? 0.0 : (1.0 - std::sqrt(1.0 - ka * ka)) / curvature;
+    // Lateral distance from the circle (its offset at this along, to second order).
+    const double predicted = heading * along + 0.5 * curvature * along * along;
     if (std::abs(d.dot(normal) - predicted) > options.max_point_distance_m) continue;
     beyond.push_back(along);
   }
