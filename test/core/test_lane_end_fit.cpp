@@ -51,25 +51,6 @@ TEST(FitLaneEnds, ExtendsByWholeChordSpacingsAlongTheLine) {
               1e-9);
 }
 
-TEST(FitLaneEnds, GrowsAlongAnArcOfRadius30m) {
-  // Points up to 15 m past the end of a lane on an arc of R = 30 m: 3.7 m off the end's
-  // tangent at 15 m, beyond max_point_distance_m of a straight extrapolation. The lane grows
-  // over them, its new control points on the arc.
-  const double R = 30.0;
-  auto on_arc = [R](double s) {
-    return Eigen::Vector3d(R * std::sin(s / R), R * (1.0 - std::cos(s / R)), 0.0);
-  };
-  std::vector<Eigen::Vector3d> cps;
-  for (int k = -1; k <= 5; ++k) cps.push_back(on_arc(3.0 * k));  // real points s = 0..12
-  std::vector<Eigen::Vector3d> points;
-  for (double s = 10.0; s <= 27.0; s += 0.25) points.push_back(on_arc(s));
-  const auto grown = FitLaneEnds(cps, points, LaneEndFitOptions());
-  ASSERT_GE(grown.size(), cps.size() + 4);
-  for (std::size_t i = 1; i + 1 < grown.size(); ++i) {
-    EXPECT_LT(DistanceToArc(grown[i], R), 0.1) << i;
-  }
-}
-
 TEST(FitLaneEnds, FewOrDistantPointsDoNotExtend) {
   const auto cps = StraightControlPoints(0.0, 12.0);
   // Four points past the end (one fewer than min_points_to_extend)...

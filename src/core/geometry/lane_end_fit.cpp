@@ -23,44 +23,21 @@ Eigen::Vector4d Basis(double u) {
                                u + 4.0 * u2 - 3.0 * u3, -u2 + u3);
 }
 
-// The baseline of an end's curvature (LaneEndCurvature) and its bound (R 20 m).
-constexpr double kEndCurvatureLengthM = 15.0;
-constexpr double kMaxEndCurvature = 0.05;
-
-// Appends control points at the end of `cps` (phantom last) for the points beyond it: the
-// points within max_point_distance_m of the end's circle (its tangent and its curvature over
-// kEndCurvatureLengthM), the new control points every chord spacing on that circle (the fit
-// of step 2 then moves them to the data). Returns how many were added.
+// Appends control points at the end of `cps` (phantom last) for the points beyond it.
+// Returns how many were added.
 int ExtendEnd(const LaneEndFitOptions& options, const std::vector<Eigen::Vector3d>& points,
               std::vector<Eigen::Vector3d>* cps) {
   const std::size_t n = cps->size();
   const Eigen::Vector3d end = (*cps)[n - 2];
   Eigen::Vector3d tangent = end - (*cps)[n - 3];
-  if (tangent.head<2>().norm() < 1e-9) return 0;
+  if (tangent.norm() < 1e-9) return 0;
   tangent.normalize();
-  const Eigen::Vector3d normal =
-      Eigen::Vector3d(-tangent.y(), tangent.x(), 0.0).normalized();  // left, horizontal
-  const double curvature = std::clamp(LaneEndCurvature(*cps, true, kEndCurvatureLengthM),
-                                      -kMaxEndCurvature, kMaxEndCurvature);
-  // The last chord runs along the curve's direction half a chord back: the end's own
-  // direction is turned by half the chord's bend.
-  const double heading = 0.5 * curvature * (end - (*cps)[n - 3]).head<2>().norm();
-  // The circle's point at arc length s (straight ahead when it is flat).
-  auto on_circle = [&](double s) {
-    if (std::abs(curvature) < 1e-6) {
-      return Eigen::Vector2d(s * std::cos(heading), s * std::sin(heading));
-    }
-    return Eigen::Vector2d((std::sin(heading + curvature * s) - std::sin(heading)) / curvature,
-                           (std::cos(heading) - std::cos(heading + curvature * s)) / curvature);
-  };
   std::vector<double> beyond;
   for (const Eigen::Vector3d& p : points) {
     const Eigen::Vector3d d = p - end;
     const double along = d.dot(tangent);
     if (along <= 0.0) continue;
-    // Lateral distance from the circle (its offset at this along, to second order).
-    const double predicted = heading * along + 0.5 * curvature * along * along;
-    if (std::abs(d.dot(normal) - predicted) > options.max_point_distance_m) continue;
+    if ((d - along * tangent).norm() > options.max_point_distance_m) continue;
     beyond.push_back(along);
   }
   if (static_cast<int>(beyond.size()) < options.min_points_to_extend) return 0;
@@ -70,10 +47,7 @@ int ExtendEnd(const LaneEndFitOptions& options, const std::vector<Eigen::Vector3
   const int add = static_cast<int>(std::floor(reach / options.chord_spacing_m + 0.5));
   if (add <= 0) return 0;
   cps->pop_back();  // the old phantom
-  for (int k = 1; k <= add; ++k) {
-    const Eigen::Vector2d q = on_circle(k * options.chord_spacing_m);
-    cps->push_back(end + q.x() * tangent + q.y() * normal);
-  }
+  for (int k = 1; k <= add; ++k) cps->push_back(end + k * options.chord_spacing_m * tangent);
   cps->push_back(2.0 * cps->back() - (*cps)[cps->size() - 2]);
   return add;
 }

@@ -2,10 +2,9 @@
 // ("extend the ends as new points arrive", docs/design.md §4). g (spline_fitting.h) starts a lane
 // from one observation; every later frame hands the points of the lane's recent
 // observations to FitLaneEnds, which
-//  1. extends an end by whole chord spacings when enough points lie beyond it (within
-//     max_point_distance_m of the end's circle: its tangent and its curvature over the last
-//     15 m, not a straight line: an arc of R 30 m leaves its tangent by 3.7 m in 15 m), new
-//     control points placed on that circle;
+//  1. extends an end by whole chord spacings when enough points lie beyond it (along the
+//     end tangent, within max_point_distance_m of its line), new control points placed
+//     straight ahead;
 //  2. re-estimates, by robust linear least squares, the real control points of the segments
 //     the points fall on; the rest of the lane is held exactly.
 // Step 2, with the points' curve parameters u_i (closest points) held fixed, is linear in
