@@ -261,8 +261,9 @@ std::string Summary(const Arguments& args, const Mapper& mapper, const FrameAsse
     << e.dropped_absurd_frame << " instances); odometry reordered " << a.odometry_reordered << "\n"
     << "map: " << map.markings.size() << " markings, " << map.lanes.size() << " lanes (created "
     << c.markings_created << " markings, " << c.lanes_created << " lanes; spurious dropped "
-    << c.spurious_dropped << ", lanes merged " << c.lanes_merged << ", lane observations unused "
-    << c.lane_observations_unused << ", near a lane " << c.lane_observations_near_lane << ")\n"
+    << c.spurious_dropped << ", lanes merged " << c.lanes_merged << ", joined " << c.lanes_joined
+    << ", lane observations unused " << c.lane_observations_unused << ", near a lane "
+    << c.lane_observations_near_lane << ")\n"
     << BackendLine(mapper) << "\n"
     << CalibrationLine(mapper) << "\n"
     << FrontEndLine(mapper) << "\n"

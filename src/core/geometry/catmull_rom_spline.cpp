@@ -319,4 +319,21 @@ bool ControlPointRangeNear(const std::vector<Eigen::Vector3d>& control_points,
   return true;
 }
 
+double LaneEndCurvature(const std::vector<Eigen::Vector3d>& cps, bool at_end, double length_m) {
+  const int n = static_cast<int>(cps.size());
+  if (n < 5) return 0.0;
+  const int end = at_end ? n - 2 : 1, step = at_end ? -1 : 1;
+  int mid = end, far = end;
+  double travelled = 0.0;
+  while (far + step >= 1 && far + step <= n - 2 && travelled < length_m) {
+    travelled += (cps[far + step] - cps[far]).head<2>().norm();
+    far += step;
+    if (travelled < 0.5 * length_m) mid = far;
+  }
+  if (mid == end || mid == far || travelled < 1e-6) return 0.0;
+  const Eigen::Vector2d u = (cps[mid] - cps[far]).head<2>(), v = (cps[end] - cps[mid]).head<2>();
+  const double turn = std::atan2(u.x() * v.y() - u.y() * v.x(), u.dot(v));
+  return (at_end ? turn : -turn) / (0.5 * travelled);  // walked backwards from a start
+}
+
 }  // namespace ipm_road_mapper

@@ -1,4 +1,5 @@
 // Map JSON reading and writing (format: docs/file_formats.md).
+#include <algorithm>
 #include <cmath>
 #include <iomanip>
 #include <set>
@@ -48,7 +49,22 @@ nlohmann::json LaneToJson(const MapLane& lane) {
           {"control_points", points},
           {"observations", lane.observations},
           {"first_seen", lane.first_seen},
-          {"last_seen", lane.last_seen}};
+          {"last_seen", lane.last_seen},
+          {"predecessors", lane.predecessors},
+          {"successors", lane.successors}};
+}
+
+// An optional array of lane ids (`predecessors`, `successors`); empty when absent.
+std::vector<std::uint64_t> OptionalIds(const nlohmann::json& j, const char* key,
+                                       const std::string& where) {
+  std::vector<std::uint64_t> ids;
+  if (!j.contains(key)) return ids;
+  const std::string ids_where = Key(where, key);
+  const nlohmann::json& array = json_io::ReadArray(j.at(key), ids_where);
+  for (std::size_t k = 0; k < array.size(); ++k) {
+    ids.push_back(json_io::ReadUint64(array[k], Index(ids_where, k)));
+  }
+  return ids;
 }
 
 MapMarking MarkingFromJson(const nlohmann::json& j, const std::string& where) {
@@ -104,6 +120,8 @@ MapLane LaneFromJson(const nlohmann::json& j, const std::string& where) {
   lane.observations = json_io::OptionalInt(j, "observations", 0, where);
   lane.first_seen = json_io::OptionalNumber(j, "first_seen", 0.0, where);
   lane.last_seen = json_io::OptionalNumber(j, "last_seen", 0.0, where);
+  lane.predecessors = OptionalIds(j, "predecessors", where);
+  lane.successors = OptionalIds(j, "successors", where);
   return lane;
 }
 
@@ -238,6 +256,16 @@ VectorMap VectorMapFromJson(const nlohmann::json& j) {
     }
     if (!lane_ids.insert(map.lanes.back().id).second) {
       Fail(Index("lanes", i), "duplicate id " + std::to_string(map.lanes.back().id));
+    }
+  }
+  // Topology never names the lane itself; it may name lanes outside the file (a map cut into
+  // parts keeps each lane's links).
+  for (std::size_t i = 0; i < map.lanes.size(); ++i) {
+    const MapLane& lane = map.lanes[i];
+    for (const auto* ids : {&lane.predecessors, &lane.successors}) {
+      if (std::find(ids->begin(), ids->end(), lane.id) != ids->end()) {
+        Fail(Index("lanes", i), "topology names the lane itself");
+      }
     }
   }
   if (j.contains("trajectory")) {

@@ -75,12 +75,18 @@ void LaneTracker::Update(const std::vector<LaneObservation>& observations,
   }
   std::vector<LaneElement>& lanes = store_->lanes();
   const std::vector<int> match = AssociateLanes(lanes, candidates, options_.association);
+  // Lanes another instance of this frame explains: a different line from every unmatched
+  // one (the frame's instances share its pose error, which the gates' odometry part covers).
+  std::vector<bool> seen_now(lanes.size(), false);
+  for (const int m : match) {
+    if (m >= 0) seen_now[m] = true;
+  }
   for (std::size_t c = 0; c < candidates.size(); ++c) {
     // The start gate looks at every point of low enough uncertainty: the N best of PS alone
     // may all lie on the nearest dash of a dashed line, shorter than the gate.
     const std::vector<Eigen::Vector3d> usable_map = UsablePoints(candidates[c]);
     if (match[c] < 0) {
-      Start(candidates[c].class_id, measurements[c], usable_map, frame);
+      Start(candidates[c].class_id, measurements[c], usable_map, frame, seen_now);
       continue;
     }
     LaneElement& lane = lanes[match[c]];
@@ -110,7 +116,8 @@ void LaneTracker::Grow(LaneElement* lane, std::size_t frame_index,
 }
 
 void LaneTracker::Start(int class_id, const LaneMeasurement& measurement,
-                        const std::vector<Eigen::Vector3d>& usable_map, const FrameRecord& frame) {
+                        const std::vector<Eigen::Vector3d>& usable_map, const FrameRecord& frame,
+                        const std::vector<bool>& seen_now) {
   if (Extent(usable_map) < options_.lanes.min_new_lane_length_m) {
     ++counters_->lane_observations_unused;
     return;
@@ -119,8 +126,12 @@ void LaneTracker::Start(int class_id, const LaneMeasurement& measurement,
   loose.lane_gate_m *= 2.0;
   loose.lane_gate_sigmas *= 2.0;
   const LaneCandidate candidate{class_id, usable_map, {}, {}};
-  for (const LaneElement& lane : store_->lanes()) {
-    if (LaneAssociationCost(lane, candidate, loose) >= 0.0) {
+  for (std::size_t l = 0; l < store_->lanes().size(); ++l) {
+    // Matched by another instance of this frame, or started by one.
+    if ((l < seen_now.size() && seen_now[l]) || store_->lanes()[l].last_frame == frame.index) {
+      continue;
+    }
+    if (LaneAssociationCost(store_->lanes()[l], candidate, loose) >= 0.0) {
       ++counters_->lane_observations_near_lane;
       return;
     }
@@ -204,6 +215,43 @@ void LaneTracker::MergeLines() {
       lanes.erase(lanes.begin() + b);
       ++counters_->lanes_merged;
     }
+  }
+  JoinFragments();
+}
+
+void LaneTracker::JoinFragments() {
+  const LaneJoinOptions& join = options_.lanes.join;
+  // Ends farther apart than this cannot be joined (a cheap test before the models).
+  const double reach_m = join.max_gap_m + join.max_overlap_m + 2.0 * join.end_length_m;
+  std::vector<LaneElement>& lanes = store_->lanes();
+  // The best pair first, until none passes: each end continues into at most one lane.
+  while (true) {
+    double best_cost = -1.0;
+    std::size_t best_a = 0, best_b = 0;
+    for (std::size_t a = 0; a < lanes.size(); ++a) {
+      for (std::size_t b = 0; b < lanes.size(); ++b) {
+        if (a == b || lanes[a].class_id != lanes[b].class_id) continue;
+        const auto& ca = lanes[a].control_points_map;
+        const auto& cb = lanes[b].control_points_map;
+        if (ca.size() < 4 || cb.size() < 4 ||
+            (ca[ca.size() - 2] - cb[1]).head<2>().norm() > reach_m) {
+          continue;
+        }
+        const double cost = LaneJoinCost(lanes[a], lanes[b], join, options_.association);
+        if (cost >= 0.0 && (best_cost < 0.0 || cost < best_cost)) {
+          best_cost = cost;
+          best_a = a;
+          best_b = b;
+        }
+      }
+    }
+    if (best_cost < 0.0) return;
+    auto result = JoinLanes(lanes[best_a], lanes[best_b], join, options_.association,
+                            options_.lanes.fit.chord_spacing_m);
+    if (!result) return;  // degenerate: left apart (rare; the next merge tries again)
+    lanes[best_a] = std::move(*result);
+    lanes.erase(lanes.begin() + best_b);
+    ++counters_->lanes_joined;
   }
 }
 

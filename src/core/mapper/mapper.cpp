@@ -6,6 +6,7 @@
 
 #include "ipm_road_mapper/core/frontend/instance_extraction.h"
 #include "ipm_road_mapper/core/geometry/ipm.h"
+#include "ipm_road_mapper/core/mapper/lane_topology.h"
 #include "ipm_road_mapper/core/mapper/pose_extrapolator.h"
 #include "ipm_road_mapper/core/mapper/timing_series.h"
 
@@ -133,7 +134,11 @@ void Mapper::Reset() {
   last_stamp_ = -1.0;
 }
 
-bool Mapper::Finish(double time_budget_s) { return windows_.Finish(time_budget_s); }
+bool Mapper::Finish(double time_budget_s) {
+  const bool finished = windows_.Finish(time_budget_s);
+  lanes_.JoinFragments();  // fragments the drive's last frames left apart
+  return finished;
+}
 
 VectorMap Mapper::ExportMap(const ExportOptions& export_options) const {
   VectorMap out;
@@ -183,6 +188,7 @@ VectorMap Mapper::ExportMap(const ExportOptions& export_options) const {
     lane.last_seen = element.last_seen;
     out.lanes.push_back(std::move(lane));
   }
+  LinkLaneTopology(&out.lanes);
   const std::vector<FrameRecord>& frames = store_.frames();
   const std::size_t max_poses = export_options.max_trajectory_poses;
   const std::size_t first =

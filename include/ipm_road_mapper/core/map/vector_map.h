@@ -54,6 +54,11 @@ struct MapLane {
   int observations = 0;
   double first_seen = 0.0;
   double last_seen = 0.0;
+  // Topology where known (lane_topology.h): ids of the lanes this one continues from (its
+  // start lies on their curve: a line that goes on in another class, a fork's branch) and
+  // of the lanes that continue it (its end lies on theirs: a merge, a class change).
+  std::vector<std::uint64_t> predecessors;
+  std::vector<std::uint64_t> successors;
 };
 
 // Where the map frame's origin is on the Earth (config section `geo_origin`), and how it is

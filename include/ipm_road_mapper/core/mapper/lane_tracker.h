@@ -28,6 +28,9 @@ class LaneTracker {
   // Drops the lanes seen in one frame only and not again for
   // association.spurious_after_frames frames.
   void DropSpurious(std::size_t frame_index);
+  // Joins the lanes that continue one another (LaneContinues), until none does; runs with
+  // the merge and at the end of the drive.
+  void JoinFragments();
 
   // The lane's control points re-fit to all its selected pixels, IPMed with `T_base_cam`
   // and the frames' current poses (export of lanes no lane residual refines).
@@ -36,8 +39,11 @@ class LaneTracker {
                                                   const Eigen::Isometry3d& T_base_cam) const;
 
  private:
+  // Starts a lane unless the observation is short or near a lane (loose gates) that no
+  // other instance of this frame explains (`seen_now`, by lane index).
   void Start(int class_id, const LaneMeasurement& measurement,
-             const std::vector<Eigen::Vector3d>& usable_map, const FrameRecord& frame);
+             const std::vector<Eigen::Vector3d>& usable_map, const FrameRecord& frame,
+             const std::vector<bool>& seen_now);
   // Grows the lane's ends with this frame's usable points and refines them with the
   // selected points of its recent observations.
   void Grow(LaneElement* lane, std::size_t frame_index,

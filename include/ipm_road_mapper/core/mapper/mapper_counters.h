@@ -23,6 +23,7 @@ struct MapperCounters {
   std::uint64_t spurious_dropped = 0;
   std::uint64_t markings_inconsistent = 0;  // markings unseen where they should be: dropped
   std::uint64_t lanes_merged = 0;
+  std::uint64_t lanes_joined = 0;  // fragments of one line joined end to start (lane_join.h)
   std::uint64_t markings_merged = 0;
   std::uint64_t lane_observations_unused = 0;  // unmatched and too short / unfit to start a lane
   // Unmatched but close to a lane of its class (within twice the gates): not a new line, so

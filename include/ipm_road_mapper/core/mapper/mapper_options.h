@@ -14,6 +14,7 @@
 #include "ipm_road_mapper/core/geometry/spline_fitting.h"
 #include "ipm_road_mapper/core/io/yaml_options.h"
 #include "ipm_road_mapper/core/mapper/input_options.h"
+#include "ipm_road_mapper/core/mapper/lane_join.h"
 
 namespace ipm_road_mapper {
 
@@ -33,6 +34,7 @@ struct LaneOptions {
   int end_fit_frames = 20;             // the growth sees the selected points of this many frames
   int merge_every_n_frames = 20;       // how often lanes that turned out to be one are merged
   double min_new_lane_length_m = 3.0;  // an unmatched observation shorter than this: no lane
+  LaneJoinOptions join;                // joining the fragments of one line (lane_join.h)
 };
 
 // Odometry buffering at the mask stamp (config section `odometry`).

@@ -1,0 +1,50 @@
+// Joining the fragments of one painted line: lane A's end and lane B's start, when B
+// continues A. Each end is modelled by the data that shaped it (the selected points of the
+// observations near it, each frame weighted once): a lateral offset y(x) = a + b x + c x^2
+// in a frame along the pair's mean direction, by weighted least squares with a weak
+// curvature prior, and its covariance from the lane noise floor. The two models are
+// compared where the gap is (its middle): the lateral offset and the direction must agree
+// within their combined uncertainty (the extrapolation over the gap is in it), the gap must
+// be short, the class the same, and the two never seen in one frame (two instances of one
+// frame are two lines: the double line's halves 0.2-0.5 m apart stay apart).
+#pragma once
+
+#include <optional>
+
+#include "ipm_road_mapper/core/frontend/association.h"
+#include "ipm_road_mapper/core/map/road_map.h"
+
+namespace ipm_road_mapper {
+
+// Gates of the join (config section `lanes`, keys join_*).
+struct LaneJoinOptions {
+  double max_gap_m = 20.0;      // longest gap between A's last data and B's first
+  double max_overlap_m = 10.0;  // longest stretch where both have data
+  double end_length_m = 20.0;   // each end is modelled by its data within this length
+  double gate_sigmas = 3.0;     // offset and direction agreement, in combined sigmas
+};
+
+// Whether `first`'s end is continued by `second`'s start: the model comparison above. Both
+// lanes ordered along the line; `options.lane_position_sigma_m` and the odometry's sigma
+// give the per-frame noise floor.
+bool LaneContinues(const LaneElement& first, const LaneElement& second, const LaneJoinOptions& join,
+                   const AssociationOptions& options);
+// The same test as a cost: the larger of the offset's and the direction's disagreement in
+// combined sigmas (<= gate_sigmas), or -1 when `second` does not continue `first`. Of
+// several candidates the lowest cost is the continuation (at 0.5 m of odometry noise the
+// next lane's line 3.5 m beside can pass the gate too).
+double LaneJoinCost(const LaneElement& first, const LaneElement& second,
+                    const LaneJoinOptions& join, const AssociationOptions& options);
+
+// `first` and `second` joined into one lane (first's id and control-point indices at its
+// start): first's control points up to its last data, a bridge over the gap on the blend of
+// the two end models every `chord_spacing_m`, then second's control points from its first
+// data; histories merged by frame. Nullopt when the result would be degenerate.
+std::optional<LaneElement> JoinLanes(const LaneElement& first, const LaneElement& second,
+                                     const LaneJoinOptions& join, const AssociationOptions& options,
+                                     double chord_spacing_m);
+
+// Whether the two lanes have a measurement of one frame each (histories sorted by frame).
+bool CoObserved(const LaneElement& a, const LaneElement& b);
+
+}  // namespace ipm_road_mapper

@@ -1,0 +1,142 @@
+// Joining the fragments of one line (lane_join.h): fragments of a dashed line across a gap
+// and of an arc of R 30 m join into one lane on the line; the halves of a double line
+// (0.2-0.5 m apart, seen in the same frames), a line that ends before another lane's line
+// starts beside it or far ahead, and lines of different classes stay apart.
+#include <gtest/gtest.h>
+
+#include <cmath>
+#include <functional>
+#include <random>
+
+#include "ipm_road_mapper/core/geometry/catmull_rom_spline.h"
+#include "ipm_road_mapper/core/mapper/lane_join.h"
+
+namespace ipm_road_mapper {
+namespace {
+
+// A line as a function of arc length s: its point in the map frame.
+using Line = std::function<Eigen::Vector3d(double s)>;
+
+Line Straight(double y) {
+  return [y](double s) { return Eigen::Vector3d(s, y, 0.0); };
+}
+
+// A left turn of radius R from the origin heading +x, `offset` to the left of it.
+Line Arc(double R, double offset) {
+  return [R, offset](double s) {
+    const double a = s / R, r = R - offset;
+    return Eigen::Vector3d(r * std::sin(a), R - r * std::cos(a), 0.0);
+  };
+}
+
+// A lane along `line` over [s0, s1] (control points every 3 m, phantoms included), observed
+// in frames [f0, f1): each frame sees 12 points on the 3 m of line just behind a point that
+// moves from s0 to s1, with a per-frame offset (pose noise, 0.1 m) and per-point noise.
+LaneElement MakeLane(std::uint64_t id, int class_id, const Line& line, double s0, double s1,
+                     std::size_t f0, std::size_t f1, std::mt19937* rng) {
+  LaneElement lane;
+  lane.id = id;
+  lane.class_id = class_id;
+  for (double s = s0 - 3.0; s <= s1 + 3.0 + 1e-9; s += 3.0) {
+    lane.control_points_map.push_back(line(s));
+  }
+  std::normal_distribution<double> frame_noise(0.0, 0.1), point_noise(0.0, 0.03);
+  for (std::size_t f = f0; f < f1; ++f) {
+    LaneMeasurement m;
+    m.frame_index = f;
+    const double s_end = s0 + 3.0 + (s1 - s0 - 3.0) * (f - f0) / std::max<double>(1, f1 - f0 - 1);
+    const Eigen::Vector3d shift(0.0, frame_noise(*rng), 0.0);
+    for (int k = 0; k < 12; ++k) {
+      m.selected_map.push_back(line(s_end - 3.0 + 0.25 * k) + shift +
+                               Eigen::Vector3d(0.0, point_noise(*rng), 0.0));
+    }
+    lane.history.push_back(std::move(m));
+  }
+  lane.first_frame = f0;
+  lane.last_frame = f1 - 1;
+  return lane;
+}
+
+// Largest distance of the lane's curve, sampled every 0.5 m, from `line` over [s0, s1].
+double MaxDistanceFrom(const LaneElement& lane, const Line& line, double s0, double s1) {
+  const CatmullRomSpline spline(lane.control_points_map);
+  std::vector<Eigen::Vector3d> dense;
+  for (double s = s0 - 5.0; s <= s1 + 5.0; s += 0.05) dense.push_back(line(s));
+  double worst = 0.0;
+  for (const Eigen::Vector3d& p : spline.SampleByArcLength(0.5)) {
+    double best = 1e9;
+    for (const Eigen::Vector3d& q : dense) best = std::min(best, (p - q).norm());
+    worst = std::max(worst, best);
+  }
+  return worst;
+}
+
+TEST(LaneJoin, FragmentsOfOneDashedLineAcrossAGapJoin) {
+  std::mt19937 rng(1);
+  const Line line = Straight(1.75);
+  const LaneElement a = MakeLane(1, 2, line, 0.0, 40.0, 0, 40, &rng);
+  const LaneElement b = MakeLane(7, 2, line, 46.0, 100.0, 60, 120, &rng);
+  const LaneJoinOptions join;
+  const AssociationOptions options;
+  ASSERT_TRUE(LaneContinues(a, b, join, options));
+  EXPECT_FALSE(LaneContinues(b, a, join, options));  // b does not lead into a
+  const auto joined = JoinLanes(a, b, join, options, 3.0);
+  ASSERT_TRUE(joined.has_value());
+  EXPECT_EQ(joined->id, 1u);
+  EXPECT_EQ(joined->first_cp_index, a.first_cp_index);
+  EXPECT_EQ(joined->history.size(), a.history.size() + b.history.size());
+  EXPECT_EQ(joined->last_frame, 119u);
+  const CatmullRomSpline spline(joined->control_points_map);
+  EXPECT_NEAR(spline.Length(), 100.0, 3.0);
+  EXPECT_LT(MaxDistanceFrom(*joined, line, 0.0, 100.0), 0.1);
+}
+
+TEST(LaneJoin, FragmentsOfAnArcOfRadius30mJoin) {
+  std::mt19937 rng(2);
+  const Line line = Arc(30.0, 1.75);
+  const LaneElement a = MakeLane(1, 2, line, 0.0, 20.0, 0, 30, &rng);
+  const LaneElement b = MakeLane(2, 2, line, 26.0, 45.0, 40, 70, &rng);
+  ASSERT_TRUE(LaneContinues(a, b, LaneJoinOptions(), AssociationOptions()));
+  const auto joined = JoinLanes(a, b, LaneJoinOptions(), AssociationOptions(), 3.0);
+  ASSERT_TRUE(joined.has_value());
+  EXPECT_LT(MaxDistanceFrom(*joined, line, 0.0, 45.0), 0.15);
+}
+
+TEST(LaneJoin, HalvesOfADoubleLineStayApart) {
+  for (const double spacing : {0.2, 0.35, 0.5}) {
+    std::mt19937 rng(3);
+    // Seen together (two instances of every frame), the right half starting a little later.
+    const LaneElement left = MakeLane(1, 2, Straight(0.0), 0.0, 40.0, 0, 40, &rng);
+    const LaneElement right = MakeLane(2, 2, Straight(-spacing), 10.0, 60.0, 10, 60, &rng);
+    EXPECT_TRUE(CoObserved(left, right));
+    EXPECT_FALSE(LaneContinues(left, right, LaneJoinOptions(), AssociationOptions())) << spacing;
+  }
+}
+
+TEST(LaneJoin, ALineThatEndsIsNotContinuedByAnotherLine) {
+  std::mt19937 rng(4);
+  const LaneElement ends = MakeLane(1, 2, Straight(0.0), 0.0, 40.0, 0, 40, &rng);
+  // The next lane's line beside it (either side), a line 1 m beside it (a lane shift), and
+  // the same line far ahead (30 m, beyond join_max_gap_m).
+  for (const double y : {3.5, -3.5, 1.0}) {
+    const LaneElement beside = MakeLane(2, 2, Straight(y), 46.0, 90.0, 60, 110, &rng);
+    EXPECT_FALSE(LaneContinues(ends, beside, LaneJoinOptions(), AssociationOptions())) << y;
+  }
+  const LaneElement far = MakeLane(3, 2, Straight(0.0), 70.0, 110.0, 80, 120, &rng);
+  EXPECT_FALSE(LaneContinues(ends, far, LaneJoinOptions(), AssociationOptions()));
+  // A line leaving at 20 deg (a fork's branch) does not continue it either.
+  const double c = std::cos(20.0 * M_PI / 180.0), s = std::sin(20.0 * M_PI / 180.0);
+  const Line branch = [c, s](double t) { return Eigen::Vector3d(42.0 + c * t, s * t, 0.0); };
+  const LaneElement fork = MakeLane(4, 2, branch, 0.0, 40.0, 60, 100, &rng);
+  EXPECT_FALSE(LaneContinues(ends, fork, LaneJoinOptions(), AssociationOptions()));
+}
+
+TEST(LaneJoin, LinesOfDifferentClassesStayApart) {
+  std::mt19937 rng(5);
+  const LaneElement dashed = MakeLane(1, 2, Straight(0.0), 0.0, 40.0, 0, 40, &rng);
+  const LaneElement solid = MakeLane(2, 1, Straight(0.0), 46.0, 90.0, 60, 110, &rng);
+  EXPECT_FALSE(LaneContinues(dashed, solid, LaneJoinOptions(), AssociationOptions()));
+}
+
+}  // namespace
+}  // namespace ipm_road_mapper
