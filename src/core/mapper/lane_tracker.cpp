@@ -221,6 +221,7 @@ void LaneTracker::MergeLines() {
 
 void LaneTracker::JoinFragments() {
   const LaneJoinOptions& join = options_.lanes.join;
+  if (!join.enabled) return;
   // Ends farther apart than this cannot be joined (a cheap test before the models).
   const double reach_m = join.max_gap_m + join.max_overlap_m + 2.0 * join.end_length_m;
   std::vector<LaneElement>& lanes = store_->lanes();
