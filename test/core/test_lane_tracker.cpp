@@ -64,34 +64,6 @@ TEST(LaneTracker, TwoLanesAlongOneLineAreMerged) {
   EXPECT_EQ(rig.store.lanes()[0].history.size(), 3u);  // both histories and the new frame
 }
 
-// A straight lane observation along y = `y` over x in [8, 20] m (base_link), tight Omega_p.
-LaneObservation LineObservation(double y) {
-  LaneObservation obs;
-  obs.class_id = 2;
-  for (double x = 8.0; x <= 20.0; x += 0.5) {
-    LanePoint p;
-    p.p_base = Eigen::Vector3d(x, y, 0.0);
-    p.cov_base = 1e-4 * Eigen::Matrix2d::Identity();
-    p.score = 2e-4;
-    obs.points.push_back(p);
-  }
-  return obs;
-}
-
-TEST(LaneTracker, TwoLinesOfOneFrameStartTwoLanesUnderNoisyOdometry) {
-  // At 0.75 m of odometry noise the loose start gate reaches past the next line (3.5 m),
-  // but two instances of one frame share its pose error: both lines start (the right one
-  // used to be dropped as "near a lane").
-  MapperOptions options;
-  options.backend.pose_prior_sigma_trans_m = Eigen::Vector3d(0.75, 0.75, 0.02);
-  Rig rig(options);
-  ASSERT_GT(rig.options.association.odometry_sigma_m, 0.7);
-  const FrameRecord& frame = rig.store.AddFrame(100.0, Eigen::Isometry3d::Identity());
-  rig.tracker.Update({LineObservation(1.75), LineObservation(-1.75)}, frame);
-  EXPECT_EQ(rig.store.lanes().size(), 2u);
-  EXPECT_EQ(rig.counters.lane_observations_near_lane, 0u);
-}
-
 TEST(LaneTracker, ShortUnmatchedPieceStartsNoLane) {
   Rig rig;
   FrameInput in = RoadFrame(100.0, 0.0, false);

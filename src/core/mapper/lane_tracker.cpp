@@ -75,18 +75,12 @@ void LaneTracker::Update(const std::vector<LaneObservation>& observations,
   }
   std::vector<LaneElement>& lanes = store_->lanes();
   const std::vector<int> match = AssociateLanes(lanes, candidates, options_.association);
-  // Lanes another instance of this frame explains: a different line from every unmatched
-  // one (the frame's instances share its pose error, which the gates' odometry part covers).
-  std::vector<bool> seen_now(lanes.size(), false);
-  for (const int m : match) {
-    if (m >= 0) seen_now[m] = true;
-  }
   for (std::size_t c = 0; c < candidates.size(); ++c) {
     // The start gate looks at every point of low enough uncertainty: the N best of PS alone
     // may all lie on the nearest dash of a dashed line, shorter than the gate.
     const std::vector<Eigen::Vector3d> usable_map = UsablePoints(candidates[c]);
     if (match[c] < 0) {
-      Start(candidates[c].class_id, measurements[c], usable_map, frame, seen_now);
+      Start(candidates[c].class_id, measurements[c], usable_map, frame);
       continue;
     }
     LaneElement& lane = lanes[match[c]];
@@ -116,8 +110,7 @@ void LaneTracker::Grow(LaneElement* lane, std::size_t frame_index,
 }
 
 void LaneTracker::Start(int class_id, const LaneMeasurement& measurement,
-                        const std::vector<Eigen::Vector3d>& usable_map, const FrameRecord& frame,
-                        const std::vector<bool>& seen_now) {
+                        const std::vector<Eigen::Vector3d>& usable_map, const FrameRecord& frame) {
   if (Extent(usable_map) < options_.lanes.min_new_lane_length_m) {
     ++counters_->lane_observations_unused;
     return;
@@ -126,12 +119,8 @@ void LaneTracker::Start(int class_id, const LaneMeasurement& measurement,
   loose.lane_gate_m *= 2.0;
   loose.lane_gate_sigmas *= 2.0;
   const LaneCandidate candidate{class_id, usable_map, {}, {}};
-  for (std::size_t l = 0; l < store_->lanes().size(); ++l) {
-    // Matched by another instance of this frame, or started by one.
-    if ((l < seen_now.size() && seen_now[l]) || store_->lanes()[l].last_frame == frame.index) {
-      continue;
-    }
-    if (LaneAssociationCost(store_->lanes()[l], candidate, loose) >= 0.0) {
+  for (const LaneElement& lane : store_->lanes()) {
+    if (LaneAssociationCost(lane, candidate, loose) >= 0.0) {
       ++counters_->lane_observations_near_lane;
       return;
     }

@@ -39,11 +39,9 @@ class LaneTracker {
                                                   const Eigen::Isometry3d& T_base_cam) const;
 
  private:
-  // Starts a lane unless the observation is short or near a lane (loose gates) that no
-  // other instance of this frame explains (`seen_now`, by lane index).
+  // Starts a lane unless the observation is short or near a lane (loose gates).
   void Start(int class_id, const LaneMeasurement& measurement,
-             const std::vector<Eigen::Vector3d>& usable_map, const FrameRecord& frame,
-             const std::vector<bool>& seen_now);
+             const std::vector<Eigen::Vector3d>& usable_map, const FrameRecord& frame);
   // Grows the lane's ends with this frame's usable points and refines them with the
   // selected points of its recent observations.
   void Grow(LaneElement* lane, std::size_t frame_index,
