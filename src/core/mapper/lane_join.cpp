@@ -6,6 +6,7 @@
 #include <limits>
 
 #include "ipm_road_mapper/core/geometry/catmull_rom_spline.h"
+#include "ipm_road_mapper/core/mapper/shared_frames.h"
 
 namespace ipm_road_mapper {
 namespace {
@@ -199,19 +200,7 @@ std::optional<PairAnalysis> Analyze(const LaneElement& first, const LaneElement&
 
 }  // namespace
 
-bool CoObserved(const LaneElement& a, const LaneElement& b) {
-  auto i = a.history.begin();
-  auto j = b.history.begin();
-  while (i != a.history.end() && j != b.history.end()) {
-    if (i->frame_index == j->frame_index) return true;
-    if (i->frame_index < j->frame_index) {
-      ++i;
-    } else {
-      ++j;
-    }
-  }
-  return false;
-}
+bool CoObserved(const LaneElement& a, const LaneElement& b) { return SeenInOneFrame(a, b); }
 
 bool LaneContinues(const LaneElement& first, const LaneElement& second, const LaneJoinOptions& join,
                    const AssociationOptions& options) {

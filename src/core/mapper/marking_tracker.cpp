@@ -8,6 +8,7 @@
 #include "ipm_road_mapper/core/frontend/association.h"
 #include "ipm_road_mapper/core/frontend/instance_extraction.h"
 #include "ipm_road_mapper/core/mapper/marking_extent.h"
+#include "ipm_road_mapper/core/mapper/shared_frames.h"
 
 namespace ipm_road_mapper {
 namespace {
@@ -39,21 +40,6 @@ constexpr double kRoadAxisMinAngleRad = 1e-3;
 constexpr std::size_t kMinSeenToConfirm = 3;
 constexpr double kMinSeenFraction = 0.5;
 constexpr std::size_t kMinExpectedToJudge = 4;
-
-// True when some frame observed both elements (their histories share a frame index).
-bool SeenTogether(const MarkingElement& a, const MarkingElement& b) {
-  auto i = a.history.begin();
-  auto j = b.history.begin();
-  while (i != a.history.end() && j != b.history.end()) {
-    if (i->frame_index == j->frame_index) return true;
-    if (i->frame_index < j->frame_index) {
-      ++i;
-    } else {
-      ++j;
-    }
-  }
-  return false;
-}
 
 // Largest horizontal distance of a corner from the center.
 double Radius(const MarkingElement& e) {
@@ -268,7 +254,7 @@ void MarkingTracker::MergeDuplicates() {
     // markings side by side are seen together; one marking's two elements never are).
     const Eigen::Matrix2d S =
         x.center_cov_map + y.center_cov_map + floor2 * Eigen::Matrix2d::Identity();
-    if (d.dot(S.ldlt().solve(d)) <= sigma_gate2 && !SeenTogether(x, y)) return true;
+    if (d.dot(S.ldlt().solve(d)) <= sigma_gate2 && !SeenInOneFrame(x, y)) return true;
     if (o.marking_merge_overlap <= 0.0) return false;
     if (d.norm() > Radius(x) + Radius(y)) return false;  // rectangles that cannot touch
     return OverlapOfSmaller(x.corners_map, y.corners_map) >= o.marking_merge_overlap;
