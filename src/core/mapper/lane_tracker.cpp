@@ -88,6 +88,7 @@ void LaneTracker::Update(const std::vector<LaneObservation>& observations,
     lane.last_frame = frame.index;
     lane.last_seen = frame.stamp;
     Grow(&lane, frame.index, usable_map);
+    store_->Touch(&lane);
   }
   if (store_->frames().size() % static_cast<std::size_t>(options_.lanes.merge_every_n_frames) ==
       0) {
@@ -143,6 +144,7 @@ void LaneTracker::Start(int class_id, const LaneMeasurement& measurement,
   lane.history.push_back(measurement);
   lane.first_frame = lane.last_frame = frame.index;
   lane.first_seen = lane.last_seen = frame.stamp;
+  store_->Touch(&lane);
   store_->lanes().push_back(std::move(lane));
   ++counters_->lanes_created;
 }
@@ -201,6 +203,7 @@ void LaneTracker::MergeLines() {
       first.control_points_map =
           FitLaneEnds(first.control_points_map, points, options_.lanes.end_fit, &added_at_start);
       first.first_cp_index -= added_at_start;
+      store_->Touch(&first);
       lanes.erase(lanes.begin() + b);
       ++counters_->lanes_merged;
     }
@@ -240,6 +243,7 @@ void LaneTracker::JoinFragments() {
                             options_.lanes.fit.chord_spacing_m);
     if (!result) return;  // degenerate: left apart (rare; the next merge tries again)
     lanes[best_a] = std::move(*result);
+    store_->Touch(&lanes[best_a]);
     lanes.erase(lanes.begin() + best_b);
     ++counters_->lanes_joined;
   }

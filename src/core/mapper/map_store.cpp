@@ -67,6 +67,7 @@ MapStore::CellKey MapStore::RetiredCellOf(const Eigen::Vector3d& p_map) const {
 void MapStore::IndexRetired(std::size_t retired_index) {
   const MarkingElement& m = map_.retired_markings[retired_index];
   retired_cells_[RetiredCellOf(m.Center())].push_back(retired_index);
+  retired_index_by_id_[m.id] = retired_index;
   max_retired_cov_trace_ = std::max(max_retired_cov_trace_, m.center_cov_map.trace());
 }
 
@@ -77,6 +78,7 @@ void MapStore::RetireMarkings(std::size_t first_frame) {
     if (live[i].retired && live[i].last_frame < first_frame) {
       map_.retired_markings.push_back(std::move(live[i]));
       IndexRetired(map_.retired_markings.size() - 1);
+      Touch(&map_.retired_markings.back());  // its place in the export changed
     } else {
       if (kept != i) live[kept] = std::move(live[i]);
       ++kept;
@@ -88,6 +90,7 @@ void MapStore::RetireMarkings(std::size_t first_frame) {
 std::size_t MapStore::ReviveMarking(std::size_t retired_index) {
   std::vector<MarkingElement>& retired = map_.retired_markings;
   map_.markings.push_back(std::move(retired[retired_index]));
+  noted_marking_ids_.insert(map_.markings.back().id);  // in the map: its removal is news
   if (retired_index + 1 != retired.size()) retired[retired_index] = std::move(retired.back());
   retired.pop_back();
   ReindexRetiredMarkings();
@@ -96,6 +99,7 @@ std::size_t MapStore::ReviveMarking(std::size_t retired_index) {
 
 void MapStore::ReindexRetiredMarkings() {
   retired_cells_.clear();
+  retired_index_by_id_.clear();
   max_retired_cov_trace_ = 0.0;
   for (std::size_t i = 0; i < map_.retired_markings.size(); ++i) IndexRetired(i);
 }
@@ -145,9 +149,48 @@ void MapStore::Clear() {
   map_.next_id = next_id;
   frame_index_.Clear();
   retired_cells_.clear();
+  retired_index_by_id_.clear();
+  noted_marking_ids_.clear();
+  noted_lane_ids_.clear();
+  changes_.Clear();
   max_retired_cov_trace_ = 0.0;
   T_map_odom_ = Eigen::Isometry3d::Identity();
   corrected_frame_ = -1;
+}
+
+bool MapStore::IsRetired(const MarkingElement* marking) const {
+  const std::vector<MarkingElement>& retired = map_.retired_markings;
+  return !retired.empty() && marking >= retired.data() && marking < retired.data() + retired.size();
+}
+
+void MapStore::Touch(MarkingElement* marking) {
+  marking->revision = changes_.Next();
+  if (IsRetired(marking)) changes_.NoteRetired(marking->revision, marking->id);
+}
+
+void MapStore::Touch(LaneElement* lane) { lane->revision = changes_.Next(); }
+
+std::int64_t MapStore::RetiredIndexOf(std::uint64_t id) const {
+  const auto it = retired_index_by_id_.find(id);
+  return it == retired_index_by_id_.end() ? -1 : static_cast<std::int64_t>(it->second);
+}
+
+void MapStore::NoteRemovals() {
+  std::unordered_set<std::uint64_t> markings, lanes;
+  markings.reserve(map_.markings.size());
+  for (const MarkingElement& m : map_.markings) markings.insert(m.id);
+  for (const LaneElement& l : map_.lanes) lanes.insert(l.id);
+  // A marking that went from live to retired is still in the map.
+  for (std::uint64_t id : noted_marking_ids_) {
+    if (!markings.count(id) && !retired_index_by_id_.count(id)) {
+      changes_.NoteRemoved(ElementKind::kMarking, id);
+    }
+  }
+  for (std::uint64_t id : noted_lane_ids_) {
+    if (!lanes.count(id)) changes_.NoteRemoved(ElementKind::kLane, id);
+  }
+  noted_marking_ids_ = std::move(markings);
+  noted_lane_ids_ = std::move(lanes);
 }
 
 Eigen::Vector3d MapStore::RoadDirectionAt(const Eigen::Vector3d& p_map) const {

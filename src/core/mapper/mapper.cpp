@@ -97,6 +97,7 @@ FrameStatus Mapper::ProcessFrame(const FrameInput& input, std::string* reason) {
   markings_.DropSpurious(frame.index);
   lanes_.DropSpurious(frame.index);
   PruneHistories();
+  store_.NoteRemovals();
   AppendBounded(&frontend_timing_.total_ms, elapsed_ms(start));
   ++counters_.frames_used;
   windows_.OnFrameUsed(counters_.frames_used, input.camera);
@@ -137,56 +138,68 @@ void Mapper::Reset() {
 bool Mapper::Finish(double time_budget_s) {
   const bool finished = windows_.Finish(time_budget_s);
   lanes_.JoinFragments();  // fragments the drive's last frames left apart
+  store_.NoteRemovals();
   return finished;
+}
+
+std::string Mapper::ClassName(int class_id) const {
+  const ClassInfo* info = classes_.Find(class_id);
+  return info ? info->name : std::string("class_") + std::to_string(class_id);
+}
+
+void Mapper::ExportExtrinsic(VectorMap* out) const {
+  out->T_base_cam = windows_.T_base_cam();
+  out->T_base_cam_initial = T_base_cam_initial_;
+  out->T_base_cam_covariance = windows_.T_base_cam_covariance();
+  out->T_base_cam_observed = windows_.extrinsic_observed();
+}
+
+bool Mapper::ExportMarking(const MarkingElement& element, MapMarking* marking) const {
+  // A tentative marking (seen once, or not yet consistently where it should have been
+  // visible: MarkingTracker::CheckConsistency) is not exported.
+  if (element.Observations() < 2 || !element.confirmed) return false;
+  marking->id = element.id;
+  marking->class_id = element.class_id;
+  marking->class_name = ClassName(element.class_id);
+  marking->corners_map = element.corners_map;
+  marking->observations = static_cast<int>(element.Observations());
+  marking->first_seen = element.first_seen;
+  marking->last_seen = element.last_seen;
+  marking->sides_measured = element.side_measured;
+  return true;
+}
+
+bool Mapper::ExportLane(const LaneElement& element, MapLane* lane) const {
+  if (element.Observations() < 2) return false;
+  lane->id = element.id;
+  lane->class_id = element.class_id;
+  lane->class_name = ClassName(element.class_id);
+  const ClassInfo* info = classes_.Find(element.class_id);
+  lane->style = info ? ToString(info->style) : "unknown";
+  // Lanes no lane residual refines are re-fit to all their points, re-IPMed with the final
+  // extrinsic and poses (PGO-IPM: lanes follow the refined extrinsic).
+  lane->control_points_map =
+      !windows_.LanesRefined()
+          ? lanes_.RefitControlPoints(element, windows_.camera(), windows_.T_base_cam())
+          : element.control_points_map;
+  lane->observations = static_cast<int>(element.Observations());
+  lane->first_seen = element.first_seen;
+  lane->last_seen = element.last_seen;
+  return true;
 }
 
 VectorMap Mapper::ExportMap(const ExportOptions& export_options) const {
   VectorMap out;
-  out.T_base_cam = windows_.T_base_cam();
-  out.T_base_cam_initial = T_base_cam_initial_;
-  out.T_base_cam_covariance = windows_.T_base_cam_covariance();
-  out.T_base_cam_observed = windows_.extrinsic_observed();
-  auto class_name = [this](int class_id) {
-    const ClassInfo* info = classes_.Find(class_id);
-    return info ? info->name : std::string("class_") + std::to_string(class_id);
-  };
-  // A tentative marking (seen once, or not yet consistently where it should have been
-  // visible: MarkingTracker::CheckConsistency) is not exported.
-  std::vector<const MarkingElement*> markings;
-  for (const MarkingElement& m : store_.markings()) markings.push_back(&m);
-  for (const MarkingElement& m : store_.retired_markings()) markings.push_back(&m);
-  for (const MarkingElement* element_ptr : markings) {
-    const MarkingElement& element = *element_ptr;
-    if (element.Observations() < 2 || !element.confirmed) continue;
-    MapMarking marking;
-    marking.id = element.id;
-    marking.class_id = element.class_id;
-    marking.class_name = class_name(element.class_id);
-    marking.corners_map = element.corners_map;
-    marking.observations = static_cast<int>(element.Observations());
-    marking.first_seen = element.first_seen;
-    marking.last_seen = element.last_seen;
-    marking.sides_measured = element.side_measured;
-    out.markings.push_back(marking);
+  ExportExtrinsic(&out);
+  for (const auto* markings : {&store_.markings(), &store_.retired_markings()}) {
+    for (const MarkingElement& m : *markings) {
+      MapMarking marking;
+      if (ExportMarking(m, &marking)) out.markings.push_back(std::move(marking));
+    }
   }
-  const bool refit = !windows_.LanesRefined();
   for (const LaneElement& element : store_.lanes()) {
-    if (element.Observations() < 2) continue;
     MapLane lane;
-    lane.id = element.id;
-    lane.class_id = element.class_id;
-    lane.class_name = class_name(element.class_id);
-    const ClassInfo* info = classes_.Find(element.class_id);
-    lane.style = info ? ToString(info->style) : "unknown";
-    // Lanes no lane residual refines are re-fit to all their points, re-IPMed with the final
-    // extrinsic and poses (PGO-IPM: lanes follow the refined extrinsic).
-    lane.control_points_map =
-        refit ? lanes_.RefitControlPoints(element, windows_.camera(), windows_.T_base_cam())
-              : element.control_points_map;
-    lane.observations = static_cast<int>(element.Observations());
-    lane.first_seen = element.first_seen;
-    lane.last_seen = element.last_seen;
-    out.lanes.push_back(std::move(lane));
+    if (ExportLane(element, &lane)) out.lanes.push_back(std::move(lane));
   }
   LinkLaneTopology(&out.lanes);
   const std::vector<FrameRecord>& frames = store_.frames();

@@ -181,11 +181,13 @@ void MarkingTracker::Associate(const std::vector<MarkingObservation>& observatio
       element.first_frame = element.last_frame = frame.index;
       element.first_seen = element.last_seen = frame.stamp;
       element.farthest_view_m = obs.center_base.head<2>().norm();
+      store_->Touch(&element);
       markings.push_back(std::move(element));
       ++counters_->markings_created;
       continue;
     }
     MarkingElement& element = markings[match[c]];
+    store_->Touch(&element);
     // Whole views pair corners by distance (as always); a partial view by side direction.
     const bool whole = element.Complete() && candidates[c].complete;
     const int shift = whole
@@ -234,6 +236,7 @@ void MarkingTracker::CheckConsistency(const Ipm& ipm, const FrameRecord& frame) 
     if (m.frames_seen >= kMinSeenToConfirm &&
         static_cast<double>(m.frames_seen) >= kMinSeenFraction * m.frames_expected) {
       m.confirmed = true;
+      store_->Touch(&m);
     }
   }
 }
@@ -272,6 +275,7 @@ void MarkingTracker::MergeDuplicates() {
         std::swap(markings[a], markings[b]);
       }
       Absorb(&markings[a], markings[b]);
+      store_->Touch(&markings[a]);
       markings.erase(markings.begin() + b);
       ++counters_->markings_merged;
     }

@@ -385,6 +385,7 @@ void WindowCoordinator::ApplyResult(const WindowResult& result, bool include_ret
       if (it == by_id.end() || (it->second->retired && !include_retired)) continue;
       it->second->corners_map = wm.corners_map;
       it->second->optimized = true;
+      store_->Touch(it->second);
     }
   }
   if (!LanesRefined()) return;
@@ -405,6 +406,7 @@ void WindowCoordinator::ApplyResult(const WindowResult& result, bool include_ret
       lane.control_points_map[k] = wl.control_points_map[j];
     }
     lane.optimized = true;
+    store_->Touch(&lane);
   }
 }
 

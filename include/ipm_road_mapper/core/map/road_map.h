@@ -43,6 +43,8 @@ struct MarkingMeasurement {
 // A mapped ground marking.
 struct MarkingElement {
   std::uint64_t id = 0;
+  // MapStore::Touch's revision of the last change of what export shows (0: never touched).
+  std::uint64_t revision = 0;
   int class_id = 0;
   std::array<Eigen::Vector3d, 4> corners_map;  // current estimate
   // x-y covariance of the estimate for association: Omega_p of the best observation (the
@@ -95,6 +97,8 @@ struct LaneMeasurement {
 // A mapped lane line.
 struct LaneElement {
   std::uint64_t id = 0;
+  // MapStore::Touch's revision of the last change of what export shows (0: never touched).
+  std::uint64_t revision = 0;
   int class_id = 0;
   std::vector<Eigen::Vector3d> control_points_map;  // Catmull-Rom, phantom ends included
   // Global index of control_points_map[0]; decreases as the lane grows at its start, so

@@ -9,10 +9,12 @@
 #include <Eigen/Geometry>
 #include <cstdint>
 #include <unordered_map>
+#include <unordered_set>
 #include <vector>
 
 #include "ipm_road_mapper/core/geometry/road_surface.h"
 #include "ipm_road_mapper/core/map/road_map.h"
+#include "ipm_road_mapper/core/mapper/change_log.h"
 #include "ipm_road_mapper/core/mapper/frame_index.h"
 
 namespace ipm_road_mapper {
@@ -62,8 +64,23 @@ class MapStore {
   // Drops the measurements of frames before `frame` from every element's history (counted
   // in `pruned`): what export and association need stays (corners, control points, spans).
   void PruneHistoriesBefore(std::size_t frame);
-  // Drops every frame and element (ids keep counting).
+  // Drops every frame and element (ids keep counting; revisions too: ChangeLog::Clear).
   void Clear();
+
+  // Change tracking (incremental export, map_changes.h). Every write of what an element's
+  // exported form shows (created, grown, re-optimized, merged into, confirmed, retired)
+  // calls Touch: the element gets a new revision, and a retired marking is logged so that
+  // an export finds it without scanning the retired ones.
+  void Touch(MarkingElement* marking);
+  void Touch(LaneElement* lane);
+  // Logs the live markings and lanes that left the map since the last call (merged away,
+  // dropped as spurious or inconsistent, joined into another lane): the Mapper calls it at
+  // the end of each step that may remove elements. Costs the live elements and lanes.
+  void NoteRemovals();
+  // The revisions and the logs of retirements and removals.
+  const ChangeLog& changes() const { return changes_; }
+  // Index of retired marking `id` in retired_markings(), or -1.
+  std::int64_t RetiredIndexOf(std::uint64_t id) const;
 
   const RoadMap& map() const { return map_; }
   const std::vector<FrameRecord>& frames() const { return map_.frames; }
@@ -90,8 +107,16 @@ class MapStore {
   CellKey RetiredCellOf(const Eigen::Vector3d& p_map) const;
   void IndexRetired(std::size_t retired_index);
 
+  // Whether `marking` is an element of retired_markings().
+  bool IsRetired(const MarkingElement* marking) const;
+
   double road_plane_radius_m_;
   RoadMap map_;
+  ChangeLog changes_;
+  // Retired marking id -> index in retired_markings (kept with retired_cells_).
+  std::unordered_map<std::uint64_t, std::size_t> retired_index_by_id_;
+  // The live marking ids and the lane ids as of the last NoteRemovals.
+  std::unordered_set<std::uint64_t> noted_marking_ids_, noted_lane_ids_;
   FrameIndex frame_index_;
   // Retired markings by the grid cell of their center (cells of kRetiredCellM).
   std::unordered_map<CellKey, std::vector<std::size_t>> retired_cells_;

@@ -20,6 +20,7 @@
 #include "ipm_road_mapper/core/geometry/pinhole_camera.h"
 #include "ipm_road_mapper/core/map/vector_map.h"
 #include "ipm_road_mapper/core/mapper/lane_tracker.h"
+#include "ipm_road_mapper/core/mapper/map_changes.h"
 #include "ipm_road_mapper/core/mapper/map_store.h"
 #include "ipm_road_mapper/core/mapper/mapper_counters.h"
 #include "ipm_road_mapper/core/mapper/mapper_options.h"
@@ -86,6 +87,13 @@ class Mapper {
   // are re-fit to all their selected pixels, re-IPMed with the current extrinsic and poses.
   VectorMap ExportMap(const ExportOptions& options = ExportOptions()) const;
 
+  // The incremental export (map_changes.h): what ExportMap's elements changed after
+  // revision `since` (0: all of them), and the ids it no longer exports. Costs the live
+  // markings, the lanes and what changed; retired markings only when they changed.
+  MapChanges ExportChanges(std::uint64_t since) const;
+  // The map's revision now (MapChanges::revision).
+  std::uint64_t revision() const { return store_.changes().revision(); }
+
   // Optimizer statistics (zeros without a back end).
   BackendStats backend_stats() const { return windows_.stats(); }
 
@@ -129,6 +137,13 @@ class Mapper {
   // frames) from the histories: no later step reads them, and memory then grows with the
   // map, not with the frames seen.
   void PruneHistories();
+  // ExportMap's form of one element: false when export skips it (tentative, seen once).
+  bool ExportMarking(const MarkingElement& element, MapMarking* marking) const;
+  bool ExportLane(const LaneElement& element, MapLane* lane) const;
+  // The exported name of class `class_id` ("class_<id>" when the table has none).
+  std::string ClassName(int class_id) const;
+  // The extrinsic fields of an export.
+  void ExportExtrinsic(VectorMap* out) const;
 
   // Declaration order is construction order: the rooms hold pointers to what precedes them.
   const MapperOptions options_;

@@ -1,0 +1,50 @@
+// The map's revisions: a counter the MapStore bumps on every change of an element's exported
+// form (MapStore::Touch), and the two logs an incremental export needs so that it never
+// scans the retired markings: which retired markings changed at which revision, and which
+// element ids left the map at which revision. Both logs are appended in revision order.
+#pragma once
+
+#include <cstdint>
+#include <utility>
+#include <vector>
+
+#include "ipm_road_mapper/core/frontend/class_table.h"  // ElementKind
+
+namespace ipm_road_mapper {
+
+class ChangeLog {
+ public:
+  // A new revision, larger than every one before.
+  std::uint64_t Next() { return ++revision_; }
+  // The newest revision handed out (0: none).
+  std::uint64_t revision() const { return revision_; }
+
+  // Retired marking `id` changed (or retired) at `revision`.
+  void NoteRetired(std::uint64_t revision, std::uint64_t id);
+  // Element `id` of `kind` left the map; gets a new revision.
+  void NoteRemoved(ElementKind kind, std::uint64_t id);
+
+  // The (revision, id) entries of retired markings noted after `since`, oldest first; an
+  // id may appear more than once (the caller keeps the entry matching its revision).
+  std::vector<std::pair<std::uint64_t, std::uint64_t>> RetiredSince(std::uint64_t since) const;
+  // The ids of `kind` removed after `since`, in removal order.
+  std::vector<std::uint64_t> RemovedSince(ElementKind kind, std::uint64_t since) const;
+
+  // Everything before now is forgotten (a reset): revisions keep counting, and a request
+  // for changes since an older revision must take the whole map (cleared_at()).
+  void Clear();
+  // The revision of the last Clear (0: never).
+  std::uint64_t cleared_at() const { return cleared_at_; }
+
+ private:
+  using Entry = std::pair<std::uint64_t, std::uint64_t>;  // (revision, id)
+  static std::vector<Entry>::const_iterator After(const std::vector<Entry>& log,
+                                                  std::uint64_t since);
+
+  std::uint64_t revision_ = 0;
+  std::uint64_t cleared_at_ = 0;
+  std::vector<Entry> retired_;
+  std::vector<Entry> removed_markings_, removed_lanes_;
+};
+
+}  // namespace ipm_road_mapper
