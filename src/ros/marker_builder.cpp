@@ -104,88 +104,150 @@ MarkerBuilder::MarkerBuilder(double lane_sample_spacing_m, std::size_t lane_chun
     : lane_sample_spacing_m_(lane_sample_spacing_m > 0.0 ? lane_sample_spacing_m : 0.5),
       lane_chunk_segments_(std::max<std::size_t>(lane_chunk_segments, 1)) {}
 
+void MarkerBuilder::Add(std::size_t ns, std::size_t fingerprint, visualization_msgs::Marker marker,
+                        visualization_msgs::MarkerArray* out) {
+  published_[Key(ns, marker.id)] = {fingerprint, generation_};
+  out->markers.push_back(std::move(marker));
+}
+
+bool MarkerBuilder::Unchanged(std::size_t ns_a, std::size_t ns_b, int id, std::size_t fingerprint,
+                              Mode mode) {
+  if (mode != Mode::kChanges) return false;
+  bool any = false, same = true;
+  for (const std::size_t ns : {ns_a, ns_b}) {
+    const auto it = published_.find(Key(ns, id));
+    if (it == published_.end()) continue;
+    any = true;
+    same = same && it->second.fingerprint == fingerprint;
+  }
+  if (!any || !same) return false;
+  for (const std::size_t ns : {ns_a, ns_b}) {
+    const auto it = published_.find(Key(ns, id));
+    if (it != published_.end()) it->second.generation = generation_;
+  }
+  return true;
+}
+
+void MarkerBuilder::AddLane(const MapLane& lane, const std::string& frame_id,
+                            const ros::Time& stamp, Mode mode,
+                            visualization_msgs::MarkerArray* out) {
+  using visualization_msgs::Marker;
+  const std::vector<Eigen::Vector3d>& cps = lane.control_points_map;
+  const std_msgs::ColorRGBA color = ClassColor(lane.class_id, lane.class_name);
+  const std::vector<LaneChunk> chunks = LaneChunks(cps.size(), lane_chunk_segments_);
+  std::size_t& drawn = lane_chunks_[lane.id];
+  drawn = std::max(drawn, chunks.size());
+  for (const LaneChunk& chunk : chunks) {
+    const int id = LaneChunkMarkerId(lane.id, chunk.index);
+    const std::size_t fingerprint = GeometryFingerprint(lane, chunk.curve_first, chunk.curve_last);
+    if (Unchanged(kLaneNs, kControlPointNs, id, fingerprint, mode)) continue;
+    Marker line = NewMarker(kNamespaces[kLaneNs], id, Marker::LINE_STRIP, frame_id, stamp);
+    line.scale.x = 0.15;  // line width, m (a painted lane line)
+    line.color = color;
+    for (const Eigen::Vector3d& p :
+         CurveSamples(cps, chunk.curve_first, chunk.curve_last, lane_sample_spacing_m_)) {
+      line.points.push_back(ToPointMsg(p));
+    }
+    if (line.points.size() >= 2) Add(kLaneNs, fingerprint, std::move(line), out);
+    Marker points =
+        NewMarker(kNamespaces[kControlPointNs], id, Marker::SPHERE_LIST, frame_id, stamp);
+    points.scale.x = points.scale.y = points.scale.z = 0.3;
+    points.color = Rgba(color.r * 0.6f, color.g * 0.6f, color.b * 0.6f + 0.4f);
+    for (std::size_t i = chunk.points_first; i < chunk.points_last; ++i) {
+      points.points.push_back(ToPointMsg(cps[i]));
+    }
+    if (!points.points.empty()) Add(kControlPointNs, fingerprint, std::move(points), out);
+  }
+}
+
+void MarkerBuilder::AddMarking(const MapMarking& marking, const std::string& frame_id,
+                               const ros::Time& stamp, Mode mode,
+                               visualization_msgs::MarkerArray* out) {
+  using visualization_msgs::Marker;
+  const int id = MarkerId(marking.id);
+  const std::size_t fingerprint = GeometryFingerprint(marking);
+  if (Unchanged(kMarkingNs, kLabelNs, id, fingerprint, mode)) return;
+  const std_msgs::ColorRGBA color = ClassColor(marking.class_id, marking.class_name);
+  Marker outline = NewMarker(kNamespaces[kMarkingNs], id, Marker::LINE_STRIP, frame_id, stamp);
+  outline.scale.x = 0.08;
+  outline.color = color;
+  for (int i = 0; i <= 4; ++i) outline.points.push_back(ToPointMsg(marking.corners_map[i % 4]));
+  Add(kMarkingNs, fingerprint, std::move(outline), out);
+  Marker label = NewMarker(kNamespaces[kLabelNs], id, Marker::TEXT_VIEW_FACING, frame_id, stamp);
+  label.pose.position = ToPointMsg(marking.Center() + Eigen::Vector3d(0.0, 0.0, 0.5));
+  label.scale.z = 0.6;  // text height, m
+  label.color = color;
+  label.text =
+      marking.class_name.empty() ? "class " + std::to_string(marking.class_id) : marking.class_name;
+  Add(kLabelNs, fingerprint, std::move(label), out);
+}
+
+void MarkerBuilder::DeleteIfStale(std::uint64_t key, const std::string& frame_id,
+                                  const ros::Time& stamp, visualization_msgs::MarkerArray* out) {
+  const auto it = published_.find(key);
+  if (it == published_.end() || it->second.generation == generation_) return;
+  visualization_msgs::Marker gone =
+      NewMarker(kNamespaces[key >> 32], static_cast<int>(key & 0xffffffffu),
+                visualization_msgs::Marker::LINE_STRIP, frame_id, stamp);
+  gone.action = visualization_msgs::Marker::DELETE;
+  out->markers.push_back(gone);
+  published_.erase(it);
+}
+
 visualization_msgs::MarkerArray MarkerBuilder::Build(const VectorMap& map,
                                                      const std::string& frame_id,
                                                      const ros::Time& stamp, Mode mode) {
-  using visualization_msgs::Marker;
   visualization_msgs::MarkerArray out;
   ++generation_;
-  std::size_t fingerprint = 0;
-  auto add = [&](std::size_t ns, Marker marker) {
-    published_[Key(ns, marker.id)] = {fingerprint, generation_};
-    out.markers.push_back(std::move(marker));
-  };
-  // kChanges: an element drawn before with the same fingerprint keeps its markers as sent.
-  auto unchanged = [&](std::size_t ns_a, std::size_t ns_b, int id) {
-    if (mode != Mode::kChanges) return false;
-    bool any = false, same = true;
-    for (const std::size_t ns : {ns_a, ns_b}) {
-      const auto it = published_.find(Key(ns, id));
-      if (it == published_.end()) continue;
-      any = true;
-      same = same && it->second.fingerprint == fingerprint;
-    }
-    if (!any || !same) return false;
-    for (const std::size_t ns : {ns_a, ns_b}) {
-      const auto it = published_.find(Key(ns, id));
-      if (it != published_.end()) it->second.generation = generation_;
-    }
-    return true;
-  };
-  for (const MapLane& lane : map.lanes) {
-    const std::vector<Eigen::Vector3d>& cps = lane.control_points_map;
-    const std_msgs::ColorRGBA color = ClassColor(lane.class_id, lane.class_name);
-    for (const LaneChunk& chunk : LaneChunks(cps.size(), lane_chunk_segments_)) {
-      const int id = LaneChunkMarkerId(lane.id, chunk.index);
-      fingerprint = GeometryFingerprint(lane, chunk.curve_first, chunk.curve_last);
-      if (unchanged(kLaneNs, kControlPointNs, id)) continue;
-      Marker line = NewMarker(kNamespaces[kLaneNs], id, Marker::LINE_STRIP, frame_id, stamp);
-      line.scale.x = 0.15;  // line width, m (a painted lane line)
-      line.color = color;
-      for (const Eigen::Vector3d& p :
-           CurveSamples(cps, chunk.curve_first, chunk.curve_last, lane_sample_spacing_m_)) {
-        line.points.push_back(ToPointMsg(p));
-      }
-      if (line.points.size() >= 2) add(kLaneNs, std::move(line));
-      Marker points =
-          NewMarker(kNamespaces[kControlPointNs], id, Marker::SPHERE_LIST, frame_id, stamp);
-      points.scale.x = points.scale.y = points.scale.z = 0.3;
-      points.color = Rgba(color.r * 0.6f, color.g * 0.6f, color.b * 0.6f + 0.4f);
-      for (std::size_t i = chunk.points_first; i < chunk.points_last; ++i) {
-        points.points.push_back(ToPointMsg(cps[i]));
-      }
-      if (!points.points.empty()) add(kControlPointNs, std::move(points));
-    }
-  }
-  for (const MapMarking& marking : map.markings) {
-    const int id = MarkerId(marking.id);
-    fingerprint = GeometryFingerprint(marking);
-    if (unchanged(kMarkingNs, kLabelNs, id)) continue;
-    const std_msgs::ColorRGBA color = ClassColor(marking.class_id, marking.class_name);
-    Marker outline = NewMarker(kNamespaces[kMarkingNs], id, Marker::LINE_STRIP, frame_id, stamp);
-    outline.scale.x = 0.08;
-    outline.color = color;
-    for (int i = 0; i <= 4; ++i) outline.points.push_back(ToPointMsg(marking.corners_map[i % 4]));
-    add(kMarkingNs, std::move(outline));
-    Marker label = NewMarker(kNamespaces[kLabelNs], id, Marker::TEXT_VIEW_FACING, frame_id, stamp);
-    label.pose.position = ToPointMsg(marking.Center() + Eigen::Vector3d(0.0, 0.0, 0.5));
-    label.scale.z = 0.6;  // text height, m
-    label.color = color;
-    label.text = marking.class_name.empty() ? "class " + std::to_string(marking.class_id)
-                                            : marking.class_name;
-    add(kLabelNs, std::move(label));
-  }
+  lane_chunks_.clear();
+  for (const MapLane& lane : map.lanes) AddLane(lane, frame_id, stamp, mode, &out);
+  for (const MapMarking& marking : map.markings) AddMarking(marking, frame_id, stamp, mode, &out);
   // What this map no longer draws: deleted on screen and forgotten.
-  for (auto it = published_.begin(); it != published_.end();) {
-    if (it->second.generation == generation_) {
-      ++it;
-      continue;
+  std::vector<std::uint64_t> stale;
+  for (const auto& [key, sent] : published_) {
+    if (sent.generation != generation_) stale.push_back(key);
+  }
+  for (std::uint64_t key : stale) DeleteIfStale(key, frame_id, stamp, &out);
+  return out;
+}
+
+visualization_msgs::MarkerArray MarkerBuilder::Build(const MapChanges& changes,
+                                                     const std::string& frame_id,
+                                                     const ros::Time& stamp) {
+  if (changes.complete) return Build(changes.map, frame_id, stamp, Mode::kChanges);
+  visualization_msgs::MarkerArray out;
+  ++generation_;
+  for (const MapLane& lane : changes.map.lanes) {
+    AddLane(lane, frame_id, stamp, Mode::kChanges, &out);
+    // The chunks it drew before and does not draw now (it lost points, or a chunk's curve
+    // could not be drawn).
+    for (std::size_t chunk = 0; chunk < lane_chunks_[lane.id]; ++chunk) {
+      const int id = LaneChunkMarkerId(lane.id, chunk);
+      for (const std::size_t ns : {kLaneNs, kControlPointNs}) {
+        DeleteIfStale(Key(ns, id), frame_id, stamp, &out);
+      }
     }
-    Marker gone = NewMarker(kNamespaces[it->first >> 32], static_cast<int>(it->first & 0xffffffffu),
-                            Marker::LINE_STRIP, frame_id, stamp);
-    gone.action = Marker::DELETE;
-    out.markers.push_back(gone);
-    it = published_.erase(it);
+    lane_chunks_[lane.id] = LaneChunks(lane.control_points_map.size(), lane_chunk_segments_).size();
+  }
+  for (const MapMarking& marking : changes.map.markings) {
+    AddMarking(marking, frame_id, stamp, Mode::kChanges, &out);
+  }
+  for (std::uint64_t lane_id : changes.removed_lane_ids) {
+    const auto it = lane_chunks_.find(lane_id);
+    if (it == lane_chunks_.end()) continue;
+    for (std::size_t chunk = 0; chunk < it->second; ++chunk) {
+      const int id = LaneChunkMarkerId(lane_id, chunk);
+      for (const std::size_t ns : {kLaneNs, kControlPointNs}) {
+        DeleteIfStale(Key(ns, id), frame_id, stamp, &out);
+      }
+    }
+    lane_chunks_.erase(it);
+  }
+  for (std::uint64_t marking_id : changes.removed_marking_ids) {
+    const int id = MarkerId(marking_id);
+    for (const std::size_t ns : {kMarkingNs, kLabelNs}) {
+      DeleteIfStale(Key(ns, id), frame_id, stamp, &out);
+    }
   }
   return out;
 }
@@ -197,6 +259,7 @@ visualization_msgs::MarkerArray MarkerBuilder::Clear() {
   all.pose.orientation.w = 1.0;
   out.markers.push_back(all);
   published_.clear();
+  lane_chunks_.clear();
   return out;
 }
 

@@ -70,43 +70,69 @@ ipm_road_mapper::VectorMapDelta VectorMapDeltaBuilder::NewDelta(const std::strin
   return delta;
 }
 
+void VectorMapDeltaBuilder::AddMarking(const MapMarking& marking,
+                                       ipm_road_mapper::VectorMapDelta* delta) {
+  const std::size_t fingerprint = MessageFingerprint(marking);
+  const auto [it, added] = markings_.try_emplace(marking.id);
+  if (added || it->second.fingerprint != fingerprint) {
+    delta->markings.push_back(ToMarkingMsg(marking));
+  }
+  it->second = {fingerprint, generation_};
+}
+
+void VectorMapDeltaBuilder::AddLane(const MapLane& lane, LaneSent* now,
+                                    ipm_road_mapper::VectorMapDelta* delta) {
+  Describe(lane, now);
+  now->generation = generation_;
+  const auto [it, added] = lanes_.try_emplace(lane.id);
+  if (added) {
+    delta->lanes.push_back(Patch(lane, 0));
+  } else {
+    // The first chunk that differs: the points before it are as sent.
+    const LaneSent& before = it->second;
+    std::size_t chunk = 0;
+    while (chunk < now->chunks.size() && chunk < before.chunks.size() &&
+           now->chunks[chunk] == before.chunks[chunk]) {
+      ++chunk;
+    }
+    const std::size_t first = std::min(chunk * lane_chunk_points_, now->points);
+    const bool points_changed = first < now->points || now->points != before.points;
+    if (points_changed || now->fields != before.fields) delta->lanes.push_back(Patch(lane, first));
+  }
+  std::swap(it->second, *now);  // `now` keeps the old chunk vector's memory for the next lane
+}
+
 ipm_road_mapper::VectorMapDelta VectorMapDeltaBuilder::Build(const VectorMap& map,
                                                              const std::string& frame_id,
                                                              const ros::Time& stamp) {
   ipm_road_mapper::VectorMapDelta delta = NewDelta(frame_id, stamp);
   ++generation_;
-  for (const MapMarking& marking : map.markings) {
-    const std::size_t fingerprint = MessageFingerprint(marking);
-    const auto [it, added] = markings_.try_emplace(marking.id);
-    if (added || it->second.fingerprint != fingerprint) {
-      delta.markings.push_back(ToMarkingMsg(marking));
-    }
-    it->second = {fingerprint, generation_};
-  }
+  for (const MapMarking& marking : map.markings) AddMarking(marking, &delta);
   LaneSent now;
-  for (const MapLane& lane : map.lanes) {
-    Describe(lane, &now);
-    now.generation = generation_;
-    const auto [it, added] = lanes_.try_emplace(lane.id);
-    if (added) {
-      delta.lanes.push_back(Patch(lane, 0));
-    } else {
-      // The first chunk that differs: the points before it are as sent.
-      const LaneSent& before = it->second;
-      std::size_t chunk = 0;
-      while (chunk < now.chunks.size() && chunk < before.chunks.size() &&
-             now.chunks[chunk] == before.chunks[chunk]) {
-        ++chunk;
-      }
-      const std::size_t first = std::min(chunk * lane_chunk_points_, now.points);
-      const bool points_changed = first < now.points || now.points != before.points;
-      if (points_changed || now.fields != before.fields) delta.lanes.push_back(Patch(lane, first));
-    }
-    std::swap(it->second, now);  // `now` keeps the old chunk vector's memory for the next lane
-  }
+  for (const MapLane& lane : map.lanes) AddLane(lane, &now, &delta);
   delta.removed_marking_ids = EraseUnseen(&markings_, generation_);
   delta.removed_lane_ids = EraseUnseen(&lanes_, generation_);
   delta.base_to_camera = IsometryToTransform(map.T_base_cam);
+  return delta;
+}
+
+ipm_road_mapper::VectorMapDelta VectorMapDeltaBuilder::Build(const MapChanges& changes,
+                                                             const std::string& frame_id,
+                                                             const ros::Time& stamp) {
+  if (changes.complete) return Build(changes.map, frame_id, stamp);
+  ipm_road_mapper::VectorMapDelta delta = NewDelta(frame_id, stamp);
+  ++generation_;
+  for (const MapMarking& marking : changes.map.markings) AddMarking(marking, &delta);
+  LaneSent now;
+  for (const MapLane& lane : changes.map.lanes) AddLane(lane, &now, &delta);
+  // What left the map, of what was sent (the ids come sorted).
+  for (std::uint64_t id : changes.removed_marking_ids) {
+    if (markings_.erase(id)) delta.removed_marking_ids.push_back(id);
+  }
+  for (std::uint64_t id : changes.removed_lane_ids) {
+    if (lanes_.erase(id)) delta.removed_lane_ids.push_back(id);
+  }
+  delta.base_to_camera = IsometryToTransform(changes.map.T_base_cam);
   return delta;
 }
 

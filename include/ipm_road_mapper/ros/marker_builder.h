@@ -10,7 +10,10 @@
 // dropped spurious marking, a reset) gets a DELETE, so rviz never shows stale markers, and
 // in kChanges mode an element whose fingerprint did not change is not built nor sent again
 // (the per-publish cost then follows what changed, not the map's length): a lane that grows
-// at its end re-sends its last chunk or two, not the whole lane. Marking marker ids are
+// at its end re-sends its last chunk or two, not the whole lane. Built from the core's
+// incremental export (MapChanges), it looks at the changed and removed elements only. The
+// markers are those of kChanges on the whole map (the DELETEs may come in another order).
+// Marking marker ids are
 // the element ids (mod 2^31); lane chunk ids are LaneChunkMarkerId; both stable over the
 // element's life.
 #pragma once
@@ -28,6 +31,7 @@
 #include <vector>
 
 #include "ipm_road_mapper/core/map/vector_map.h"
+#include "ipm_road_mapper/core/mapper/map_changes.h"
 
 namespace ipm_road_mapper {
 
@@ -66,6 +70,13 @@ class MarkerBuilder {
   visualization_msgs::MarkerArray Build(const VectorMap& map, const std::string& frame_id,
                                         const ros::Time& stamp, Mode mode = Mode::kFull);
 
+  // kChanges from the core's changes since the previous call's map (its revision or an
+  // older one): the markers of the changed elements whose class or geometry changed, and
+  // DELETEs for the removed elements' markers and a changed lane's vanished chunks. A
+  // complete `changes` is Build(changes.map, kChanges).
+  visualization_msgs::MarkerArray Build(const MapChanges& changes, const std::string& frame_id,
+                                        const ros::Time& stamp);
+
   // One DELETEALL marker (after ~reset); forgets what was published.
   visualization_msgs::MarkerArray Clear();
 
@@ -75,11 +86,28 @@ class MarkerBuilder {
     std::size_t fingerprint = 0;
     std::uint64_t generation = 0;
   };
+  // Adds the markers of `lane` (of `marking`) that are not unchanged in kChanges mode.
+  void AddLane(const MapLane& lane, const std::string& frame_id, const ros::Time& stamp, Mode mode,
+               visualization_msgs::MarkerArray* out);
+  void AddMarking(const MapMarking& marking, const std::string& frame_id, const ros::Time& stamp,
+                  Mode mode, visualization_msgs::MarkerArray* out);
+  // Records `marker` as published now with `fingerprint` and appends it to *out.
+  void Add(std::size_t ns, std::size_t fingerprint, visualization_msgs::Marker marker,
+           visualization_msgs::MarkerArray* out);
+  // kChanges: true (and the markers kept as of this Build) when an element drawn before
+  // under namespaces ns_a / ns_b and `id` has the same fingerprint.
+  bool Unchanged(std::size_t ns_a, std::size_t ns_b, int id, std::size_t fingerprint, Mode mode);
+  // DELETEs the marker `key` when published but not drawn by this Build.
+  void DeleteIfStale(std::uint64_t key, const std::string& frame_id, const ros::Time& stamp,
+                     visualization_msgs::MarkerArray* out);
+
   double lane_sample_spacing_m_;
   std::size_t lane_chunk_segments_;
   // Every marker on screen now, by (namespace index << 32 | id).
   std::unordered_map<std::uint64_t, Sent> published_;
   std::uint64_t generation_ = 0;  // Build calls so far
+  // Chunks drawn of each lane (the incremental build deletes the ones a lane lost).
+  std::unordered_map<std::uint64_t, std::size_t> lane_chunks_;
 };
 
 }  // namespace ipm_road_mapper

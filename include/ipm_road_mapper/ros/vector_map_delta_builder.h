@@ -3,7 +3,9 @@
 // (LaneSplinePatch), and the ids of the elements that left the map. It remembers a
 // fingerprint per marking and per chunk of each lane's control points, so a message
 // carries what changed, not the whole map: retired markings, which no solve moves any
-// more, are sent once; a lane that grows sends its last chunk or two.
+// more, are sent once; a lane that grows sends its last chunk or two. Built from the core's
+// incremental export (MapChanges), it looks at the changed elements only: its cost follows
+// what changed, not the map's length; the message is the one Build(VectorMap) would make.
 #pragma once
 
 #include <ros/time.h>
@@ -16,6 +18,7 @@
 
 #include "ipm_road_mapper/VectorMapDelta.h"
 #include "ipm_road_mapper/core/map/vector_map.h"
+#include "ipm_road_mapper/core/mapper/map_changes.h"
 
 namespace ipm_road_mapper {
 
@@ -27,6 +30,12 @@ class VectorMapDeltaBuilder {
   // The delta from the previous call's map to `map`, in `frame_id` at `stamp` (the first
   // call: every element).
   ipm_road_mapper::VectorMapDelta Build(const VectorMap& map, const std::string& frame_id,
+                                        const ros::Time& stamp);
+
+  // The same delta from the core's changes since the previous call's map (its revision or
+  // an older one): only the changed elements are compared; a complete `changes` (the first
+  // export, after a reset) is Build(changes.map).
+  ipm_road_mapper::VectorMapDelta Build(const MapChanges& changes, const std::string& frame_id,
                                         const ros::Time& stamp);
 
   // A delta with `reset` set and nothing else (after ~reset); forgets every element.
@@ -47,6 +56,11 @@ class VectorMapDeltaBuilder {
   };
   // Fills *sent with what `lane`'s patch would depend on (generation untouched).
   void Describe(const MapLane& lane, LaneSent* sent) const;
+  // Adds `marking` to `delta` when new or changed, and remembers it as of this generation.
+  void AddMarking(const MapMarking& marking, ipm_road_mapper::VectorMapDelta* delta);
+  // Adds `lane`'s patch from its first changed chunk, when new or changed; `scratch` keeps
+  // its vector's memory from lane to lane.
+  void AddLane(const MapLane& lane, LaneSent* scratch, ipm_road_mapper::VectorMapDelta* delta);
   ipm_road_mapper::VectorMapDelta NewDelta(const std::string& frame_id, const ros::Time& stamp);
 
   std::size_t lane_chunk_points_;
