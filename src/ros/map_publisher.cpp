@@ -27,15 +27,17 @@ MapPublisher::MapPublisher(ros::NodeHandle& private_nh, int path_max_poses,
 PublishCounts MapPublisher::Publish(const VectorMap& map, const std::string& map_frame,
                                     const std::string& base_frame,
                                     const std::string& refined_camera_frame, const ros::Time& stamp,
-                                    bool map_changed) {
+                                    bool map_changed, const MapChanges* changes) {
   std::lock_guard<std::mutex> lock(mutex_);
   PublishCounts counts;
   const ros::WallTime now = ros::WallTime::now();
   const bool full = new_marker_subscriber_.exchange(false) || last_full_markers_.isZero() ||
                     now - last_full_markers_ >= marker_full_period_;
   if (full) last_full_markers_ = now;
-  const visualization_msgs::MarkerArray markers = markers_.Build(
-      map, map_frame, stamp, full ? MarkerBuilder::Mode::kFull : MarkerBuilder::Mode::kChanges);
+  const visualization_msgs::MarkerArray markers =
+      full ? markers_.Build(map, map_frame, stamp, MarkerBuilder::Mode::kFull)
+      : changes ? markers_.Build(*changes, map_frame, stamp)
+                : markers_.Build(map, map_frame, stamp, MarkerBuilder::Mode::kChanges);
   if (!markers.markers.empty()) {
     markers_pub_.publish(markers);
     counts.markers = markers.markers.size();
@@ -43,7 +45,8 @@ PublishCounts MapPublisher::Publish(const VectorMap& map, const std::string& map
   }
   if (map_changed) {
     full_map_stale_ = true;
-    const ipm_road_mapper::VectorMapDelta delta = deltas_.Build(map, map_frame, stamp);
+    const ipm_road_mapper::VectorMapDelta delta =
+        changes ? deltas_.Build(*changes, map_frame, stamp) : deltas_.Build(map, map_frame, stamp);
     delta_pub_.publish(delta);
     counts.delta_elements = delta.markings.size() + delta.lanes.size() +
                             delta.removed_marking_ids.size() + delta.removed_lane_ids.size();

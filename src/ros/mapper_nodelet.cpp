@@ -232,8 +232,10 @@ void MapperNodelet::OnPublishTimer() {
   const double cpu_start_ms = ThreadCpuMs();
   const PublishCounts counts = map_publisher_->Publish(
       *snapshot->map, snapshot->map_frame, config_.mapper.input.base_frame,
-      snapshot->refined_camera_frame, FromSeconds(snapshot->newest_frame_stamp), changed);
+      snapshot->refined_camera_frame, FromSeconds(snapshot->newest_frame_stamp), changed,
+      snapshot->changes.get());
   const double cpu_ms = ThreadCpuMs() - cpu_start_ms;
+  if (changed && snapshot->changes) worker_->Published(snapshot->resets, snapshot->changes->revision);
   std::lock_guard<std::mutex> lock(stats_mutex_);
   ++publishes_;
   publish_last_ = counts;

@@ -323,14 +323,28 @@ MapperStatusSnapshot MappingWorker::Status() const {
   return s;
 }
 
+void MappingWorker::Published(std::uint64_t resets, std::uint64_t revision) {
+  std::lock_guard<std::mutex> lock(published_mutex_);
+  published_resets_ = resets;
+  published_revision_ = revision;
+}
+
 void MappingWorker::Export() {
   if (session_.started() && (map_version_ != exported_version_ || !exported_map_)) {
     exported_map_ = ExportMap(false);
+    std::uint64_t since = 0;  // a publisher of an older map (before a reset) gets everything
+    {
+      std::lock_guard<std::mutex> lock(published_mutex_);
+      if (published_resets_ == generation_) since = published_revision_;
+    }
+    exported_changes_ =
+        std::make_shared<const MapChanges>(session_.mapper()->ExportChanges(since));
   }
   exported_version_ = map_version_;
   status_dirty_ = false;
   auto snapshot = std::make_shared<MapSnapshot>();
   snapshot->map = exported_map_;
+  snapshot->changes = exported_changes_;
   snapshot->trajectory_prefix = exported_prefix_;
   snapshot->map_version = map_version_;
   snapshot->resets = generation_;

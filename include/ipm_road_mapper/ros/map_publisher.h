@@ -20,6 +20,7 @@
 #include <string>
 
 #include "ipm_road_mapper/core/map/vector_map.h"
+#include "ipm_road_mapper/core/mapper/map_changes.h"
 #include "ipm_road_mapper/ros/marker_builder.h"
 #include "ipm_road_mapper/ros/vector_map_delta_builder.h"
 
@@ -46,9 +47,13 @@ class MapPublisher {
   // base_frame -> refined_camera_frame. `map_changed` false: only a due full marker set or
   // full ~vector_map (the map was published before). Thread-safe (one publication at a
   // time).
+  // `changes` (optional): the core's changes of `map` since the revision of the last map
+  // published or an older one (MapChanges): the delta and the changed markers are then
+  // built from them, at a cost that follows what changed; the full sets still from `map`.
   PublishCounts Publish(const VectorMap& map, const std::string& map_frame,
                         const std::string& base_frame, const std::string& refined_camera_frame,
-                        const ros::Time& stamp, bool map_changed = true);
+                        const ros::Time& stamp, bool map_changed = true,
+                        const MapChanges* changes = nullptr);
 
   // True when the next Publish sends the full marker set (a new ~markers subscriber, or
   // the period elapsed).

@@ -39,6 +39,10 @@ struct MapSnapshot {
   std::shared_ptr<const VectorMap> map;  // with the nodelet's metadata; nullptr before start
   TrajectoryChunks trajectory_prefix;    // the poses before map->trajectory
   std::uint64_t map_version = 0;         // changes whenever the map may have changed
+  // The core's changes of `map` since the revision the publisher last acknowledged
+  // (MappingWorker::Published; everything before that): what the delta and the changed
+  // markers are built from. nullptr before start.
+  std::shared_ptr<const MapChanges> changes;
   std::uint64_t resets = 0;              // ~resets before this map (its generation)
   double newest_frame_stamp = 0.0;       // of the newest used frame (s)
   std::string map_frame = "map";
@@ -83,6 +87,11 @@ class MappingWorker {
 
   // The newest snapshot (never nullptr).
   std::shared_ptr<const MapSnapshot> Latest() const;
+
+  // From the publisher, after it published snapshot `resets` / `revision`
+  // (changes->revision): later snapshots carry the changes since then. Never blocks on the
+  // mapping thread.
+  void Published(std::uint64_t resets, std::uint64_t revision);
 
   // Items dropped because the queue was full, per InputKind.
   std::array<std::uint64_t, kInputKindCount> dropped() const;
@@ -136,12 +145,16 @@ class MappingWorker {
   bool status_dirty_ = true;
   double newest_frame_stamp_ = 0.0;
   std::shared_ptr<const VectorMap> exported_map_;
+  std::shared_ptr<const MapChanges> exported_changes_;  // of exported_map_
   FrozenTrajectory frozen_trajectory_;  // the poses no solve changes any more
   TrajectoryChunks exported_prefix_;    // frozen_trajectory_'s chunks as of exported_map_
   Clock::time_point next_export_, last_overlay_;
 
   BoundedInputQueue<MapperInputItem> queue_;
   std::array<std::atomic<std::uint64_t>, kInputKindCount> dropped_{};
+
+  std::mutex published_mutex_;  // held only to read / write the two below
+  std::uint64_t published_resets_ = 0, published_revision_ = 0;
 
   mutable std::mutex snapshot_mutex_;  // held only to swap / copy the pointer
   std::shared_ptr<const MapSnapshot> latest_;

@@ -17,7 +17,8 @@ MapChanges Mapper::ExportChanges(std::uint64_t since) const {
   const ChangeLog& log = store_.changes();
   MapChanges out;
   out.revision = log.revision();
-  out.complete = since == 0 || since < log.cleared_at();
+  // A revision this map never had (a client of another Mapper) asks for everything too.
+  out.complete = since == 0 || since < log.cleared_at() || since > log.revision();
   if (out.complete) since = 0;
   out.since = since;
   ExportExtrinsic(&out.map);
