@@ -7,7 +7,12 @@ through `map_from_bag --stats-out` (per frame: cumulative process CPU and RSS) a
 table: CPU ms per frame per tenth of the drive, last / first tenth, peak RSS, RSS growth per
 km, map bytes per km, start-up time, time taken, and marking / lane APE per sixth of the
 drive (the map and the ground truth cropped to each sixth, then evaluate_map on each; the
-cropping is long_drive_split.py). Figures are measured and printed; nothing is asserted.
+cropping is long_drive_split.py). With --publish-stats-out (PublishCostProbe) it also prints
+the map publication's CPU per publish at 1, 3 and 10 km (median of the publishes measured
+just past each km): the delta and changed markers built from the core's incremental export
+as the nodelet does, the core's export time for it, and beside them the old whole-map way
+(ExportMap plus fingerprints of every element). Figures are measured and printed; nothing
+is asserted.
 """
 import csv
 import json
@@ -23,6 +28,9 @@ import long_drive_split
 
 SCENARIO = "public_road_long"
 STATS_HEADER = ["frame", "stamp", "cpu_s", "rss_kb"]
+PUBLISH_HEADER = ["km", "frame", "stamp", "markings", "lanes", "changed_elements",
+                  "export_changes_ms", "export_map_ms", "publish_ms", "publish_old_ms"]
+PUBLISH_KMS = (1, 3, 10)
 TENTHS = 10
 SIXTHS = 6
 
@@ -124,7 +132,53 @@ def map_drive(args, drive, out):
     return timed(lambda: benchmark.run(
         [os.path.join(args.bin, "map_from_bag"), "--bag", os.path.join(drive, "drive.bag"),
          "--config", os.path.join(args.repo, "config", "mapper.yaml"), "--out", out,
-         "--stats-out", os.path.join(out, "stats.csv")], os.path.join(out, "map.log")))
+         "--stats-out", os.path.join(out, "stats.csv"),
+         "--publish-stats-out", os.path.join(out, "publish.csv")], os.path.join(out, "map.log")))
+
+
+def read_publish_stats(path):
+    """The --publish-stats-out CSV as a list of dicts (None when the file is absent)."""
+    if not os.path.exists(path):
+        return None
+    with open(path) as f:
+        rows = list(csv.reader(f))
+    if not rows or rows[0] != PUBLISH_HEADER:
+        sys.exit("benchmark --long: %s: expected the header %s" % (path, ",".join(PUBLISH_HEADER)))
+    return [dict(zip(PUBLISH_HEADER, map(float, r))) for r in rows[1:] if r]
+
+
+def median(values):
+    """The median of `values` (None when empty)."""
+    values = sorted(values)
+    n = len(values)
+    if n == 0:
+        return None
+    return values[n // 2] if n % 2 else 0.5 * (values[n // 2 - 1] + values[n // 2])
+
+
+def publish_rows(publish):
+    """Table rows: the publication's CPU per publish near 1, 3 and 10 km (those the drive
+    reached: its last whole km stands in for a larger one)."""
+    if not publish:
+        return []
+    reached = int(max(r["km"] for r in publish))
+    kms = sorted({min(km, reached) for km in PUBLISH_KMS if min(km, reached) >= 1})
+    parts = {km: [r for r in publish if int(r["km"]) == km] for km in kms}
+    fmt = benchmark.fmt
+
+    def column(key):
+        return " / ".join(fmt(median([r[key] for r in parts[km]]), 3) for km in kms)
+
+    label = "/".join(str(km) for km in kms)
+    counts = " / ".join(str(len(parts[km])) for km in kms)
+    elements = " / ".join(fmt(median([r["markings"] + r["lanes"] for r in parts[km]]), 0)
+                          for km in kms)
+    return [["publish CPU per publish at %s km (delta + markers)" % label,
+             "%s ms (old whole-map way %s ms)" % (column("publish_ms"), column("publish_old_ms"))],
+            ["core export per publish at %s km" % label,
+             "%s ms ExportChanges (ExportMap %s ms)" % (column("export_changes_ms"),
+                                                         column("export_map_ms"))],
+            ["publishes measured / map elements at %s km" % label, "%s / %s" % (counts, elements)]]
 
 
 def evaluate(args, map_path, gt_path, metrics_path):
@@ -211,6 +265,7 @@ def report(args, drive, out, generate_time, map_time):
     for k, (d0, d1, marking, lane, recall) in enumerate(sixths):
         rows.append(["marking / lane APE, sixth %d (%.1f-%.1f km)" % (k + 1, d0 / 1e3, d1 / 1e3),
                      "%s / %s m (marking recall %s)" % (fmt(marking), fmt(lane), fmt(recall, 2))])
+    rows += publish_rows(read_publish_stats(os.path.join(out, "publish.csv")))
     benchmark.table("Long drive: %s, config/mapper.yaml, seed 1" % SCENARIO,
                     ["quantity", "value"], rows)
     json.dump({"rows": rows}, open(os.path.join(out, "long_results.json"), "w"), indent=1)

@@ -35,7 +35,7 @@ PublishCounts MapPublisher::Publish(const VectorMap& map, const std::string& map
                     now - last_full_markers_ >= marker_full_period_;
   if (full) last_full_markers_ = now;
   const visualization_msgs::MarkerArray markers =
-      full ? markers_.Build(map, map_frame, stamp, MarkerBuilder::Mode::kFull)
+      full      ? markers_.Build(map, map_frame, stamp, MarkerBuilder::Mode::kFull)
       : changes ? markers_.Build(*changes, map_frame, stamp)
                 : markers_.Build(map, map_frame, stamp, MarkerBuilder::Mode::kChanges);
   if (!markers.markers.empty()) {

@@ -235,7 +235,8 @@ void MapperNodelet::OnPublishTimer() {
       snapshot->refined_camera_frame, FromSeconds(snapshot->newest_frame_stamp), changed,
       snapshot->changes.get());
   const double cpu_ms = ThreadCpuMs() - cpu_start_ms;
-  if (changed && snapshot->changes) worker_->Published(snapshot->resets, snapshot->changes->revision);
+  if (changed && snapshot->changes)
+    worker_->Published(snapshot->resets, snapshot->changes->revision);
   std::lock_guard<std::mutex> lock(stats_mutex_);
   ++publishes_;
   publish_last_ = counts;

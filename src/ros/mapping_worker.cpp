@@ -337,8 +337,7 @@ void MappingWorker::Export() {
       std::lock_guard<std::mutex> lock(published_mutex_);
       if (published_resets_ == generation_) since = published_revision_;
     }
-    exported_changes_ =
-        std::make_shared<const MapChanges>(session_.mapper()->ExportChanges(since));
+    exported_changes_ = std::make_shared<const MapChanges>(session_.mapper()->ExportChanges(since));
   }
   exported_version_ = map_version_;
   status_dirty_ = false;

@@ -2,6 +2,7 @@
 //
 //   rosrun ipm_road_mapper map_from_bag --bag <bag> [--config <yaml>] [--classes <yaml>]
 //                                       [--async] --out <dir> [--stats-out <csv>]
+//                                       [--publish-stats-out <csv>]
 //
 // The back end solves every window in turn (backend.synchronous forced on: offline the bag
 // is read far faster than real time, and an owned optimizer thread would drop most
@@ -14,7 +15,8 @@
 // and with odometry interpolated at its stamp (FrameAssembler, the same code the nodelet
 // uses), runs the core Mapper, and writes <dir>/map.json, <dir>/map.geojson,
 // <dir>/map_trajectory_tum.txt and <dir>/summary.txt (with startup_s: process start to the first
-// frame mapped), and with --stats-out a CSV row per frame (CPU time, RSS). The rough
+// frame mapped), with --stats-out a CSV row per frame (CPU time, RSS), and with
+// --publish-stats-out the publication's CPU per publish near each km (PublishCostProbe). The rough
 // extrinsic T_base_cam is the config's input.extrinsic when given, else the bag's /tf_static
 // transform from input.base_frame to the mask's header.frame_id (a chain of static transforms
 // is composed). Defaults: --config and --classes are config/mapper.yaml and
@@ -61,6 +63,7 @@
 #include "ipm_road_mapper/ros/bag_input.h"
 #include "ipm_road_mapper/ros/bag_mapping.h"
 #include "ipm_road_mapper/ros/bag_read_loss.h"
+#include "ipm_road_mapper/ros/publish_cost_probe.h"
 #include "ipm_road_mapper/ros/unindexed_bag.h"
 
 namespace ipm_road_mapper {
@@ -75,9 +78,10 @@ struct InputError : std::runtime_error {
 
 struct Arguments {
   std::string bag, config, classes, out;
-  std::string stats_out;        // empty: no per-frame stats file
-  std::string calibration_out;  // empty: no calibration file
-  bool async = false;           // keep backend.synchronous as configured (live-like timing)
+  std::string stats_out;          // empty: no per-frame stats file
+  std::string publish_stats_out;  // empty: no publish-cost CSV
+  std::string calibration_out;    // empty: no calibration file
+  bool async = false;             // keep backend.synchronous as configured (live-like timing)
 };
 
 // A file of the package (e.g. "config/mapper.yaml"); see the file comment for the search.
@@ -106,6 +110,9 @@ std::optional<int> ParseArguments(int argc, char** argv, Arguments* args) {
       .Required("out", "<dir>", &args->out, "output folder (created if needed)")
       .Optional("stats-out", "<file>", &args->stats_out, "none",
                 "per-frame CSV frame,stamp,cpu_s,rss_kb (docs/map_from_bag.md)")
+      .Optional("publish-stats-out", "<file>", &args->publish_stats_out, "none",
+                "CSV of the map publication's CPU per publish near each whole km, built from "
+                "the incremental export and the old whole-map way (docs/map_from_bag.md)")
       .Optional("calibration-out", "<file.yaml>", &args->calibration_out, "none",
                 "the refined extrinsic as a config whose input.extrinsic the next run reads, "
                 "with a static_transform_publisher line and a URDF joint (docs/map_from_bag.md)");
@@ -343,6 +350,14 @@ int Run(int argc, char** argv) {
   // Opened before mapping, so an unwritable path fails at once (exit 1).
   std::optional<FrameStatsWriter> frame_stats;
   if (!args.stats_out.empty()) frame_stats.emplace(args.stats_out);
+  std::optional<PublishCostProbe> publish_probe;
+  if (!args.publish_stats_out.empty()) {
+    try {
+      publish_probe.emplace(args.publish_stats_out, config.ros.publish_rate_hz);
+    } catch (const std::runtime_error& e) {
+      throw InputError(e.what());
+    }
+  }
 
   // The same pipeline as the nodelet's; no odometry wait rule offline (the bag is complete).
   MappingSession session(options, classes);
@@ -360,6 +375,7 @@ int Run(int argc, char** argv) {
   BagMappingCallbacks callbacks;
   callbacks.frame_done = [&](std::size_t frame, double stamp) {
     if (frame_stats) frame_stats->Add(frame, stamp);
+    if (publish_probe) publish_probe->OnFrame(*session.mapper(), frame, stamp);
     progress.Update(frame + 1);
   };
   callbacks.first_frame_mapped = [&stats] {
@@ -391,6 +407,7 @@ int Run(int argc, char** argv) {
   const std::string summary = Summary(args, mapper, session.assembler(), map, stats);
   try {
     if (frame_stats) frame_stats->Close();
+    if (publish_probe) publish_probe->Close();
     WriteOutputs(args.out, map, config.geo_origin, summary);
     if (!args.calibration_out.empty()) {
       Calibration calibration;

@@ -43,8 +43,8 @@ struct MapSnapshot {
   // (MappingWorker::Published; everything before that): what the delta and the changed
   // markers are built from. nullptr before start.
   std::shared_ptr<const MapChanges> changes;
-  std::uint64_t resets = 0;              // ~resets before this map (its generation)
-  double newest_frame_stamp = 0.0;       // of the newest used frame (s)
+  std::uint64_t resets = 0;         // ~resets before this map (its generation)
+  double newest_frame_stamp = 0.0;  // of the newest used frame (s)
   std::string map_frame = "map";
   std::string refined_camera_frame;  // tf child of the refined extrinsic ("" before start)
   MapperStatusSnapshot status;       // the session's counters for the diagnostics
@@ -146,8 +146,8 @@ class MappingWorker {
   double newest_frame_stamp_ = 0.0;
   std::shared_ptr<const VectorMap> exported_map_;
   std::shared_ptr<const MapChanges> exported_changes_;  // of exported_map_
-  FrozenTrajectory frozen_trajectory_;  // the poses no solve changes any more
-  TrajectoryChunks exported_prefix_;    // frozen_trajectory_'s chunks as of exported_map_
+  FrozenTrajectory frozen_trajectory_;                  // the poses no solve changes any more
+  TrajectoryChunks exported_prefix_;  // frozen_trajectory_'s chunks as of exported_map_
   Clock::time_point next_export_, last_overlay_;
 
   BoundedInputQueue<MapperInputItem> queue_;
