@@ -29,7 +29,8 @@ import long_drive_split
 SCENARIO = "public_road_long"
 STATS_HEADER = ["frame", "stamp", "cpu_s", "rss_kb"]
 PUBLISH_HEADER = ["km", "frame", "stamp", "markings", "lanes", "changed_elements",
-                  "export_changes_ms", "export_map_ms", "publish_ms", "publish_old_ms"]
+                  "export_changes_ms", "export_snapshot_ms", "export_map_ms", "publish_ms",
+                  "publish_old_ms"]
 PUBLISH_KMS = (1, 3, 10)
 TENTHS = 10
 SIXTHS = 6
@@ -178,6 +179,8 @@ def publish_rows(publish):
             ["core export per publish at %s km" % label,
              "%s ms ExportChanges (ExportMap %s ms)" % (column("export_changes_ms"),
                                                          column("export_map_ms"))],
+            ["nodelet snapshot export at %s km (ExportMap, no lane topology)" % label,
+             "%s ms" % column("export_snapshot_ms")],
             ["publishes measured / map elements at %s km" % label, "%s / %s" % (counts, elements)]]
 
 

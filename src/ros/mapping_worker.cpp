@@ -5,6 +5,8 @@
 #include <algorithm>
 #include <utility>
 
+#include "ipm_road_mapper/core/mapper/lane_topology.h"
+
 namespace ipm_road_mapper {
 namespace {
 
@@ -25,6 +27,7 @@ std::shared_ptr<const VectorMap> MapSnapshot::FullMap() const {
   if (!map) return nullptr;
   auto full = std::make_shared<VectorMap>(*map);
   full->trajectory = FullTrajectory(trajectory_prefix, map->trajectory);
+  LinkLaneTopology(&full->lanes);  // a live snapshot's map has none (ExportOptions)
   return full;
 }
 
@@ -294,6 +297,9 @@ std::shared_ptr<VectorMap> MappingWorker::ExportMap(bool whole_trajectory) {
     frozen_trajectory_.Extend(frames, frames.size() - mutable_frames);
   }
   ExportOptions options;  // max_trajectory_poses 0: every pose
+  // The finished map is saved as it is; a snapshot's map is published, and FullMap links
+  // the topology of a copy for a save.
+  options.lane_topology = whole_trajectory;
   if (!whole_trajectory) {
     exported_prefix_ = frozen_trajectory_.chunks();
     options.max_trajectory_poses = frames.size() - frozen_trajectory_.size();

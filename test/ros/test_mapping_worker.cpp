@@ -209,3 +209,31 @@ TEST(MappingWorker, FinishBeforeAnyFrameHasNoMap) {
 
 }  // namespace
 }  // namespace ipm_road_mapper
+
+namespace ipm_road_mapper {
+namespace {
+
+// A live snapshot's map has no lane topology (no message carries it, and linking it costs
+// the lanes' count times their length on every export); the copy a save writes has it.
+TEST(MapSnapshot, FullMapLinksTheLaneTopologyTheSnapshotSkips) {
+  auto lane = [](std::uint64_t id, double x0) {
+    MapLane l;
+    l.id = id;
+    l.class_id = 2;
+    for (int i = -1; i <= 11; ++i) l.control_points_map.emplace_back(x0 + 2.0 * i, 0.0, 0.0);
+    l.observations = 3;
+    return l;
+  };
+  auto map = std::make_shared<VectorMap>();
+  map->lanes = {lane(1, 0.0), lane(2, 20.0)};  // 2 starts where 1 ends
+  MapSnapshot snapshot;
+  snapshot.map = map;
+  const std::shared_ptr<const VectorMap> full = snapshot.FullMap();
+  ASSERT_EQ(full->lanes.size(), 2u);
+  EXPECT_EQ(full->lanes[0].successors, std::vector<std::uint64_t>{2});
+  EXPECT_EQ(full->lanes[1].predecessors, std::vector<std::uint64_t>{1});
+  EXPECT_TRUE(snapshot.map->lanes[0].successors.empty());  // the snapshot's own map untouched
+}
+
+}  // namespace
+}  // namespace ipm_road_mapper

@@ -49,7 +49,8 @@ struct MapSnapshot {
   std::string refined_camera_frame;  // tf child of the refined extrinsic ("" before start)
   MapperStatusSnapshot status;       // the session's counters for the diagnostics
 
-  // The map with its whole trajectory (a copy: what a save writes); nullptr without a map.
+  // The map with its whole trajectory and the lanes' topology (a copy: what a save writes;
+  // `map` has no topology, which no message carries); nullptr without a map.
   std::shared_ptr<const VectorMap> FullMap() const;
 };
 

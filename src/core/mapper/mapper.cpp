@@ -201,7 +201,7 @@ VectorMap Mapper::ExportMap(const ExportOptions& export_options) const {
     MapLane lane;
     if (ExportLane(element, &lane)) out.lanes.push_back(std::move(lane));
   }
-  LinkLaneTopology(&out.lanes);
+  if (export_options.lane_topology) LinkLaneTopology(&out.lanes);
   const std::vector<FrameRecord>& frames = store_.frames();
   const std::size_t max_poses = export_options.max_trajectory_poses;
   const std::size_t first =

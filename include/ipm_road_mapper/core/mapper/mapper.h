@@ -57,6 +57,10 @@ struct ExportOptions {
   // The corrected trajectory's newest poses only (a live snapshot for ~corrected_path);
   // 0 = every pose (map files).
   std::size_t max_trajectory_poses = 0;
+  // Link the lanes' predecessors and successors (LinkLaneTopology). Its cost grows with the
+  // lanes' count times their length (0.6 s at 10 km): a live snapshot for publication, whose
+  // messages carry no topology, skips it, and a save links it on its copy.
+  bool lane_topology = true;
 };
 
 class Mapper {
