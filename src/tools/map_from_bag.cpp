@@ -350,13 +350,9 @@ int Run(int argc, char** argv) {
   // Opened before mapping, so an unwritable path fails at once (exit 1).
   std::optional<FrameStatsWriter> frame_stats;
   if (!args.stats_out.empty()) frame_stats.emplace(args.stats_out);
-  std::optional<PublishCostProbe> publish_probe;
+  std::optional<PublishCostProbe> publish_probe;  // an unwritable path: exit 1, as above
   if (!args.publish_stats_out.empty()) {
-    try {
-      publish_probe.emplace(args.publish_stats_out, config.ros.publish_rate_hz);
-    } catch (const std::runtime_error& e) {
-      throw InputError(e.what());
-    }
+    publish_probe.emplace(args.publish_stats_out, config.ros.publish_rate_hz);
   }
 
   // The same pipeline as the nodelet's; no odometry wait rule offline (the bag is complete).

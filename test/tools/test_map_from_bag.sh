@@ -252,7 +252,7 @@ if [ "$help_rc" -ne 0 ] || [ -s "$work/help.err" ]; then
   fail "--help: exit $help_rc, stderr: $(cat "$work/help.err")"
 else
   missing=""
-  for option in --bag --config --classes --async --out --stats-out --help; do
+  for option in --bag --config --classes --async --out --stats-out --publish-stats-out --help; do
     grep -q -- "$option" "$work/help.txt" || missing="$missing $option"
   done
   described=$(grep -o -e "(default: " -e "(required)" "$work/help.txt" | wc -l)
@@ -304,6 +304,14 @@ if [ "$rc" -eq 1 ] && [ "$(wc -l <"$work/stderr")" -eq 1 ] && grep -q "stats" "$
   pass "unwritable --stats-out -> exit 1: $(cat "$work/stderr")"
 else
   fail "unwritable --stats-out: exit $rc: $(cat "$work/stderr")"
+fi
+rc=0
+run_mapper --bag "$work/drive.bag" --out "$work/x" --publish-stats-out "$work/no_dir/publish.csv" \
+  >/dev/null 2>"$work/stderr" || rc=$?
+if [ "$rc" -eq 1 ] && [ "$(wc -l <"$work/stderr")" -eq 1 ] && grep -q "publish.csv" "$work/stderr"; then
+  pass "unwritable --publish-stats-out -> exit 1: $(cat "$work/stderr")"
+else
+  fail "unwritable --publish-stats-out: exit $rc: $(cat "$work/stderr")"
 fi
 
 # 9. --calibration-out: the refined extrinsic as a config the next run starts from (on the
