@@ -7,6 +7,7 @@
 #include <optional>
 
 #include "ipm_road_mapper/core/backend/window_extrinsic.h"
+#include "ipm_road_mapper/core/backend/window_extrinsic_validation.h"
 #include "ipm_road_mapper/core/backend/window_map_step.h"
 #include "ipm_road_mapper/core/backend/window_measurements.h"
 #include "ipm_road_mapper/core/backend/window_pose_step.h"
@@ -67,6 +68,10 @@ WindowResult SolveWindow(const WindowSnapshot& snapshot, const BackendOptions& o
       reference.reset();
     }
     if (usable && options.pose_update) run(false);
+  }
+  if (snapshot.cross_validate_extrinsic && options.optimize_extrinsic && usable) {
+    result.extrinsic_directions_reverted =
+        CrossValidateExtrinsic(snapshot, options, remaining_s(), &state);
   }
   FillCalibration(snapshot, state, &result);
 
