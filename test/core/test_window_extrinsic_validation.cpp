@@ -1,6 +1,6 @@
 // The cross-validation of the refined extrinsic (window_extrinsic_validation.h): a direction
-// keeps its refinement only when independent parts of the data (halves in time, markings
-// against lanes) each observe it and agree on it; and ExtrinsicObservability::Unobserve.
+// keeps its refinement only when independent parts of the data (the halves in time; any
+// other split) each observe it and agree on it; and ExtrinsicObservability::CountObserved.
 #include <gtest/gtest.h>
 
 #include "ipm_road_mapper/core/backend/extrinsic_observability.h"
@@ -78,14 +78,12 @@ TEST(ConfirmedDirections, APartThatDoesNotObserveAbstains) {
   EXPECT_FALSE(ConfirmedDirections(o, w_full, {}, 4.0)[DirectionOf(o, 5)]);
 }
 
-TEST(ExtrinsicObservability, UnobserveRecountsRankAndAxes) {
+TEST(ExtrinsicObservability, CountObservedRecountsRankAndAxes) {
   ExtrinsicObservability o = RollYawZObserved();
   ASSERT_EQ(o.rank, 3);
   ASSERT_TRUE(o.axis_observed[0]);
-  std::array<bool, 6> keep;
-  keep.fill(true);
-  keep[DirectionOf(o, 0)] = false;
-  o.Unobserve(keep);
+  o.observed[DirectionOf(o, 0)] = false;  // the cross-validation sent roll back
+  o.CountObserved();
   EXPECT_EQ(o.rank, 2);
   EXPECT_FALSE(o.axis_observed[0]);
   EXPECT_TRUE(o.axis_observed[2]);

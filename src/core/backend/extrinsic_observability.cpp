@@ -69,11 +69,6 @@ ExtrinsicObservability AnalyzeObservability(const Matrix6d& information,
   return o;
 }
 
-void ExtrinsicObservability::Unobserve(const std::array<bool, 6>& keep) {
-  for (int k = 0; k < 6; ++k) observed[k] = observed[k] && keep[k];
-  CountObserved();
-}
-
 void ExtrinsicObservability::CountObserved() {
   rank = 0;
   Eigen::Matrix<double, 6, Eigen::Dynamic> V_observed(6, 0);

@@ -1,6 +1,5 @@
 // Internal to SolveWindow: the cross-validation of a refined extrinsic against the rough one
-// it started from (the final global solve's; docs/backend.md, "The calibration's
-// cross-validation").
+// it started from (the final global solve's; docs/backend.md, "The drive's calibration").
 //
 // The extrinsic is one constant of the whole drive, so independent parts of the data must
 // find the same correction. A pull that one stretch of the drive or one element makes (an
