@@ -207,7 +207,8 @@ void WindowCoordinator::FinalGlobalSolve(double time_budget_s) {
   snapshot.extrinsic_prior =
       ExtrinsicPrior(T_base_cam_initial_, o.rotation_prior_sigma_rad, o.translation_prior_sigma_m);
   snapshot.newest_pose_covariance = false;  // the windows' covariance stands
-  snapshot.cross_validate_extrinsic = true;  // the drive's calibration: never worse than rough
+  // The drive's calibration: cross-validated, never moved where the data cannot confirm it.
+  snapshot.cross_validate_extrinsic = true;
   auto in_span = [start](const auto& measurement) { return measurement.frame_index >= start; };
   std::vector<const MarkingElement*> markings;
   for (const MarkingElement& m : store_->markings()) markings.push_back(&m);
