@@ -64,18 +64,23 @@ ExtrinsicObservability AnalyzeObservability(const Matrix6d& information,
   const Eigen::SelfAdjointEigenSolver<Matrix6d> eigen(H_w);
   o.eigenvalues = eigen.eigenvalues().cwiseMax(0.0);
   o.basis_whitened = eigen.eigenvectors();
+  for (int k = 0; k < 6; ++k) o.observed[k] = o.eigenvalues(k) >= min_information_ratio;
+  o.CountObserved();
+  return o;
+}
+
+void ExtrinsicObservability::CountObserved() {
+  rank = 0;
   Eigen::Matrix<double, 6, Eigen::Dynamic> V_observed(6, 0);
   for (int k = 0; k < 6; ++k) {
-    o.observed[k] = o.eigenvalues(k) >= min_information_ratio;
-    if (!o.observed[k]) continue;
-    ++o.rank;
+    if (!observed[k]) continue;
+    ++rank;
     V_observed.conservativeResize(6, V_observed.cols() + 1);
-    V_observed.col(V_observed.cols() - 1) = o.basis_whitened.col(k);
+    V_observed.col(V_observed.cols() - 1) = basis_whitened.col(k);
   }
   for (int i = 0; i < 6; ++i) {
-    o.axis_observed[i] = o.rank > 0 && V_observed.row(i).squaredNorm() >= 0.5;
+    axis_observed[i] = rank > 0 && V_observed.row(i).squaredNorm() >= 0.5;
   }
-  return o;
 }
 
 Matrix6d ExtrinsicInformation(ceres::Problem* problem, double* q_base_cam, double* t_base_cam,

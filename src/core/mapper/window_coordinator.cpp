@@ -207,6 +207,8 @@ void WindowCoordinator::FinalGlobalSolve(double time_budget_s) {
   snapshot.extrinsic_prior =
       ExtrinsicPrior(T_base_cam_initial_, o.rotation_prior_sigma_rad, o.translation_prior_sigma_m);
   snapshot.newest_pose_covariance = false;  // the windows' covariance stands
+  // The drive's calibration: cross-validated, never moved where the data cannot confirm it.
+  snapshot.cross_validate_extrinsic = true;
   auto in_span = [start](const auto& measurement) { return measurement.frame_index >= start; };
   std::vector<const MarkingElement*> markings;
   for (const MarkingElement& m : store_->markings()) markings.push_back(&m);
@@ -353,6 +355,7 @@ void WindowCoordinator::ApplyResult(const WindowResult& result, bool include_ret
   if (result.extrinsic_rejected) {
     ++counters_->extrinsic_rejected;  // T_base_cam is the previous one; so is what is known
   } else {
+    counters_->extrinsic_rejected += result.extrinsic_directions_reverted > 0 ? 1 : 0;
     extrinsic_covariance_ = result.T_base_cam_covariance;
     for (int i = 0; i < 6; ++i) observed_[i] = observed_[i] || result.extrinsic_observed[i];
   }

@@ -44,6 +44,9 @@ struct ExtrinsicObservability {
   // Rows (chart) that pin the unobserved directions: sqrt(weight) v_u^T S^-1, one per
   // unobserved eigenvector, zero rows for the observed ones (L^T L is the hold's Hessian).
   Matrix6d UnobservedHoldSqrtInformation(double weight) const;
+  // rank and axis_observed from `observed` (after a check changed it, e.g. the
+  // cross-validation of window_extrinsic_validation.h).
+  void CountObserved();
   Vector6d prior_sigma = Vector6d::Ones();  // S's diagonal
 };
 

@@ -79,6 +79,10 @@ struct WindowSnapshot {
   // Whether the result carries the Ceres covariance of the newest optimized pose (off for
   // the final global solve: its problem spans the drive).
   bool newest_pose_covariance = true;
+  // Whether the refined extrinsic is cross-validated on the two halves of the frames and
+  // falls back to the rough one (extrinsic_prior's center) in every direction they do not
+  // confirm (window_extrinsic_validation.h; on for the final global solve).
+  bool cross_validate_extrinsic = false;
 };
 
 // What the optimizer hands back (immutable once published).
@@ -103,6 +107,9 @@ struct WindowResult {
   bool extrinsic_rejected = false;
   double holdout_cost_candidate = 0.0, holdout_cost_reference = 0.0;
   int holdout_blocks = 0;
+  // The cross-validation: how many observed directions of the extrinsic it sent back to
+  // the rough value (the halves of the data disagreed on them).
+  int extrinsic_directions_reverted = 0;
   double solve_time_s = 0.0;
   int residual_blocks = 0;
   int iterations = 0;

@@ -1,0 +1,119 @@
+#include "ipm_road_mapper/core/backend/window_measurements.h"
+
+#include <algorithm>
+
+#include "ipm_road_mapper/core/frontend/marking_measurement.h"
+#include "ipm_road_mapper/core/geometry/catmull_rom_spline.h"
+#include "ipm_road_mapper/core/geometry/ipm.h"
+#include "ipm_road_mapper/core/geometry/road_surface.h"
+
+namespace ipm_road_mapper {
+namespace window_solve {
+
+void CollectCornerMeasurements(const WindowSnapshot& snapshot, const BackendOptions& options,
+                               WindowState* state) {
+  const PinholeCamera camera(snapshot.camera);
+  const Eigen::Isometry3d T_base_cam = state->extrinsic.ToIsometry();
+  for (std::size_t m = 0; m < snapshot.markings.size(); ++m) {
+    const auto& corners = state->corners[m];
+    const Eigen::Vector3d center = 0.25 * (corners[0] + corners[1] + corners[2] + corners[3]);
+    const RoadPlane plane =
+        RoadSurfaceNear(state->poses, center, options.road_plane_radius_m).plane;
+    const Eigen::Vector3d& axis = snapshot.markings[m].axis_map;
+    const auto& measurements = snapshot.markings[m].measurements;
+    // Partial views measure a marking no whole view shows (one larger than the view); where
+    // whole views exist they alone are measurements (see docs/backend.md, "Partial views").
+    const bool seen_whole =
+        std::any_of(measurements.begin(), measurements.end(),
+                    [](const MarkingMeasurement& meas) { return meas.Complete(); });
+    std::vector<std::size_t> usable;
+    for (std::size_t i = 0; i < measurements.size(); ++i) {
+      if (!seen_whole || measurements[i].Complete()) usable.push_back(i);
+    }
+    // At most max_measurements_per_marking of them, spread over the history (the first and
+    // the last included): neighbouring frames see a marking almost alike.
+    const std::size_t cap = static_cast<std::size_t>(options.max_measurements_per_marking);
+    std::vector<std::size_t> chosen;
+    if (usable.size() <= cap) {
+      chosen = usable;
+    } else {
+      for (std::size_t k = 0; k < cap; ++k) {
+        chosen.push_back(usable[k * (usable.size() - 1) / (cap - 1)]);
+      }
+    }
+    for (std::size_t i : chosen) {
+      const MarkingMeasurement& meas = measurements[i];
+      const auto slot = state->slot_of_frame.find(meas.frame_index);
+      if (slot == state->slot_of_frame.end()) continue;
+      std::array<Eigen::Vector2d, 4> corners_uv = meas.corners_uv;
+      // Whole views are re-measured on the road plane; a partial view keeps its corners as
+      // labeled (its rectangle on another plane could move a cut side onto a measured one).
+      if (meas.Complete() && !meas.outline_uv.empty() && axis.norm() > 0.0) {
+        const Eigen::Isometry3d T_map_cam = state->frames[slot->second].ToIsometry() * T_base_cam;
+        std::array<Eigen::Vector2d, 4> on_plane;
+        if (MeasureCornersOnPlane(camera, T_map_cam, plane, axis, corners, meas.outline_uv,
+                                  &on_plane)) {
+          corners_uv = on_plane;
+        }
+      }
+      for (int c = 0; c < 4; ++c) {
+        // A cut corner is no measurement (partial views): its sides may still be.
+        if (!meas.CornerMeasured(c) || !corners_uv[c].allFinite()) continue;
+        if (!ProjectsNearImage(camera, *state, slot->second, corners[c],
+                               options.max_outside_image_px))
+          continue;
+        state->corner_measurements.push_back({m, c, slot->second, corners_uv[c]});
+      }
+      for (int side = 0; side < 4; ++side) {
+        if (!meas.side_measured[side]) continue;
+        if (meas.CornerMeasured(side) && meas.CornerMeasured((side + 1) % 4)) continue;
+        for (const Eigen::Vector2d& uv : meas.side_uv[side]) {
+          state->edge_measurements.push_back({m, side, slot->second, uv});
+        }
+      }
+    }
+  }
+}
+
+void CollectLanePixels(const WindowSnapshot& snapshot, const BackendOptions& options,
+                       WindowState* state) {
+  const PinholeCamera camera(snapshot.camera);
+  const Ipm ipm(camera, snapshot.T_base_cam, 1e9);
+  for (std::size_t l = 0; l < snapshot.lanes.size(); ++l) {
+    const WindowLane& lane = snapshot.lanes[l];
+    if (lane.control_points_map.size() < 4) continue;
+    const CatmullRomSpline spline(lane.control_points_map);
+    for (const LaneMeasurement& m : lane.measurements) {
+      const auto slot = state->slot_of_frame.find(m.frame_index);
+      if (slot == state->slot_of_frame.end()) continue;
+      std::vector<std::size_t> selected;
+      for (std::size_t i = 0; i < m.points.size(); ++i) {
+        if (m.selected[i]) selected.push_back(i);
+      }
+      const std::size_t cap = static_cast<std::size_t>(options.max_lane_points_per_observation);
+      const double step = selected.size() > cap ? static_cast<double>(selected.size()) / cap : 1.0;
+      const Eigen::Isometry3d T_map_base = state->frames[slot->second].ToIsometry();
+      for (double k = 0.0; k < static_cast<double>(selected.size()); k += step) {
+        const LanePoint& point = m.points[selected[static_cast<std::size_t>(k)]];
+        Eigen::Vector3d p_base;
+        if (ipm.PixelToGround(point.uv, &p_base) != IpmStatus::kOk) continue;
+        const Eigen::Vector3d p_map = T_map_base * p_base;
+        const CatmullRomSpline::ClosestPoint closest = spline.FindClosest(p_map);
+        if (closest.distance_m > options.max_lane_pixel_distance_m) continue;
+        if (closest.s <= 0.0 || closest.s >= spline.NumSegments()) continue;  // past an end
+        const auto& cps = lane.control_points_map;
+        if (!ProjectsNearImage(camera, *state, slot->second, cps[closest.segment + 1],
+                               options.max_outside_image_px) ||
+            !ProjectsNearImage(camera, *state, slot->second, cps[closest.segment + 2],
+                               options.max_outside_image_px)) {
+          continue;
+        }
+        state->lane_pixels.push_back(
+            {l, slot->second, point.uv, closest.segment, closest.u, p_map});
+      }
+    }
+  }
+}
+
+}  // namespace window_solve
+}  // namespace ipm_road_mapper

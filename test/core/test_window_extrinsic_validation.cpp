@@ -1,0 +1,98 @@
+// The cross-validation of the refined extrinsic (window_extrinsic_validation.h): a direction
+// keeps its refinement only when independent parts of the data (the halves in time; any
+// other split) each observe it and agree on it; and ExtrinsicObservability::CountObserved.
+#include <gtest/gtest.h>
+
+#include "ipm_road_mapper/core/backend/extrinsic_observability.h"
+#include "ipm_road_mapper/core/backend/window_extrinsic_validation.h"
+
+namespace ipm_road_mapper {
+namespace window_solve {
+namespace {
+
+// Roll, yaw and z well observed (whitened information 100), the rest not.
+ExtrinsicObservability RollYawZObserved() {
+  Matrix6d H = Matrix6d::Zero();
+  H(0, 0) = H(2, 2) = H(5, 5) = 100.0;
+  H(1, 1) = H(3, 3) = H(4, 4) = 0.5;
+  return AnalyzeObservability(H, Vector6d::Ones(), 4.0);
+}
+
+// The eigen-direction of `o` along chart axis i.
+int DirectionOf(const ExtrinsicObservability& o, int i) {
+  int best = 0;
+  for (int k = 0; k < 6; ++k) {
+    if (std::abs(o.basis_whitened(i, k)) > std::abs(o.basis_whitened(i, best))) best = k;
+  }
+  return best;
+}
+
+PartEstimate Part(const Vector6d& w, double information) {
+  PartEstimate p;
+  p.w = w;
+  p.information_whitened = information * Matrix6d::Identity();
+  return p;
+}
+
+Vector6d Axis(int i, double value) {
+  Vector6d w = Vector6d::Zero();
+  w(i) = value;
+  return w;
+}
+
+TEST(ConfirmedDirections, AgreeingPartsConfirmOnlyObservedDirections) {
+  const ExtrinsicObservability o = RollYawZObserved();
+  const Vector6d w_full = Axis(0, 0.3) + Axis(3, 1.0);  // roll, and the unobserved x
+  const std::vector<std::array<PartEstimate, 2>> splits = {
+      {Part(Axis(0, 0.25) + Axis(3, 0.9), 50.0), Part(Axis(0, 0.35) + Axis(3, 1.1), 50.0)}};
+  const std::array<bool, 6> confirmed = ConfirmedDirections(o, w_full, splits, 4.0);
+  EXPECT_TRUE(confirmed[DirectionOf(o, 0)]);   // roll: both halves move it alike
+  EXPECT_FALSE(confirmed[DirectionOf(o, 3)]);  // x: never observed, never confirmed
+  EXPECT_FALSE(confirmed[DirectionOf(o, 1)]);
+}
+
+TEST(ConfirmedDirections, ADisagreeingSplitSendsTheDirectionBack) {
+  const ExtrinsicObservability o = RollYawZObserved();
+  const Vector6d w_full = Axis(0, 0.3);
+  // The halves agree; the markings and the lanes do not (one of them is biased).
+  const std::array<PartEstimate, 2> halves = {Part(Axis(0, 0.3), 50.0), Part(Axis(0, 0.3), 50.0)};
+  const std::array<PartEstimate, 2> opposite = {Part(Axis(0, 0.6), 50.0),
+                                                Part(Axis(0, -0.1), 50.0)};
+  EXPECT_FALSE(ConfirmedDirections(o, w_full, {halves, opposite}, 4.0)[DirectionOf(o, 0)]);
+  // Same sign, but apart by more than the smaller of them: one element's pull, not the drive's.
+  const std::array<PartEstimate, 2> apart = {Part(Axis(0, 0.5), 50.0), Part(Axis(0, 0.1), 50.0)};
+  EXPECT_FALSE(ConfirmedDirections(o, w_full, {halves, apart}, 4.0)[DirectionOf(o, 0)]);
+  EXPECT_TRUE(ConfirmedDirections(o, w_full, {halves}, 4.0)[DirectionOf(o, 0)]);
+}
+
+TEST(ConfirmedDirections, APartThatDoesNotObserveAbstains) {
+  const ExtrinsicObservability o = RollYawZObserved();
+  const Vector6d w_full = Axis(5, -0.4);  // z
+  // Markings see z, lanes barely (information 1 < 4): that split cannot tell; the halves do.
+  const std::array<PartEstimate, 2> halves = {Part(Axis(5, -0.45), 60.0),
+                                              Part(Axis(5, -0.35), 60.0)};
+  const std::array<PartEstimate, 2> kinds = {Part(Axis(5, -0.4), 60.0), Part(Axis(5, 0.0), 1.0)};
+  EXPECT_TRUE(ConfirmedDirections(o, w_full, {halves, kinds}, 4.0)[DirectionOf(o, 5)]);
+  // With no split able to tell, nothing is confirmed.
+  EXPECT_FALSE(ConfirmedDirections(o, w_full, {kinds}, 4.0)[DirectionOf(o, 5)]);
+  EXPECT_FALSE(ConfirmedDirections(o, w_full, {}, 4.0)[DirectionOf(o, 5)]);
+}
+
+TEST(ExtrinsicObservability, CountObservedRecountsRankAndAxes) {
+  ExtrinsicObservability o = RollYawZObserved();
+  ASSERT_EQ(o.rank, 3);
+  ASSERT_TRUE(o.axis_observed[0]);
+  o.observed[DirectionOf(o, 0)] = false;  // the cross-validation sent roll back
+  o.CountObserved();
+  EXPECT_EQ(o.rank, 2);
+  EXPECT_FALSE(o.axis_observed[0]);
+  EXPECT_TRUE(o.axis_observed[2]);
+  EXPECT_TRUE(o.axis_observed[5]);
+  EXPECT_EQ(ObservedAxesText(o.axis_observed), "yaw z");
+  // The observed information no longer holds roll.
+  EXPECT_NEAR(o.ObservedInformation()(0, 0), 0.0, 1e-9);
+}
+
+}  // namespace
+}  // namespace window_solve
+}  // namespace ipm_road_mapper
