@@ -246,24 +246,42 @@ void MarkingTracker::MergeDuplicates() {
   const double gate2 = o.marking_merge_distance_m * o.marking_merge_distance_m;
   const double floor2 = std::pow(MarkingFloorSigma(o), 2);
   const double sigma_gate2 = o.marking_gate_sigmas * o.marking_gate_sigmas;
-  auto same_marking = [&](const MarkingElement& x, const MarkingElement& y) {
+  std::vector<MarkingElement>& markings = store_->markings();
+  // Within the gate of the combined uncertainty of both elements' best views.
+  auto in_gate = [&](const MarkingElement& x, const MarkingElement& y) {
     const Eigen::Vector2d d = (x.Center() - y.Center()).head<2>();
-    if (d.squaredNorm() <= gate2) return true;
-    // Re-observed after a gap, or first seen far (IPM meters off): within the gate of the
-    // combined uncertainty of both elements' best views, and never seen in one frame (two
-    // markings side by side are seen together; one marking's two elements never are).
     const Eigen::Matrix2d S =
         x.center_cov_map + y.center_cov_map + floor2 * Eigen::Matrix2d::Identity();
-    if (d.dot(S.ldlt().solve(d)) <= sigma_gate2 && !SeenInOneFrame(x, y)) return true;
+    return d.dot(S.ldlt().solve(d)) <= sigma_gate2;
+  };
+  // A third live element of the class within the gate of either: the gate is wider than the
+  // markings' spacing (a crossing's stripes 1 m apart under 0.5 m of odometry noise), so it
+  // cannot tell which of them a copy belongs to.
+  auto ambiguous = [&](std::size_t a, std::size_t b) {
+    for (std::size_t c = 0; c < markings.size(); ++c) {
+      const MarkingElement& e = markings[c];
+      if (c == a || c == b || e.retired || e.class_id != markings[a].class_id) continue;
+      if (in_gate(markings[a], e) || in_gate(markings[b], e)) return true;
+    }
+    return false;
+  };
+  auto same_marking = [&](std::size_t a, std::size_t b) {
+    const MarkingElement& x = markings[a];
+    const MarkingElement& y = markings[b];
+    const Eigen::Vector2d d = (x.Center() - y.Center()).head<2>();
+    if (d.squaredNorm() <= gate2) return true;
+    // Re-observed after a gap, or first seen far (IPM meters off): within the uncertainty
+    // gate, never seen in one frame (two markings side by side are seen together; one
+    // marking's two elements never are), and no other element of the class in the gate.
+    if (in_gate(x, y) && !SeenInOneFrame(x, y) && !ambiguous(a, b)) return true;
     if (o.marking_merge_overlap <= 0.0) return false;
     if (d.norm() > Radius(x) + Radius(y)) return false;  // rectangles that cannot touch
     return OverlapOfSmaller(x.corners_map, y.corners_map) >= o.marking_merge_overlap;
   };
-  std::vector<MarkingElement>& markings = store_->markings();
   for (std::size_t a = 0; a < markings.size(); ++a) {
     for (std::size_t b = a + 1; b < markings.size();) {
       if (markings[a].class_id != markings[b].class_id || markings[a].retired ||
-          markings[b].retired || !same_marking(markings[a], markings[b])) {
+          markings[b].retired || !same_marking(a, b)) {
         ++b;
         continue;
       }
