@@ -4,6 +4,9 @@
 // is dropped after the spurious horizon.
 #include <gtest/gtest.h>
 
+#include <cstdint>
+#include <vector>
+
 #include "common/road_scene.h"
 #include "ipm_road_mapper/core/frontend/instance_extraction.h"
 #include "ipm_road_mapper/core/mapper/marking_tracker.h"
@@ -101,24 +104,31 @@ TEST(MarkingTracker, LoneCopyWithinTheUncertaintyGateMerges) {
   EXPECT_EQ(rig.store.markings().size(), 2u);
 }
 
-TEST(MarkingTracker, CopyAmongEvenlySpacedMarkingsIsNotMergedByTheUncertaintyGate) {
+TEST(MarkingTracker, CopyAmongEvenlySpacedMarkingsMergesIntoTheNearest) {
   // Three stripes of a crossing 1 m apart, seen together, and an element of their class seen
-  // in another frame between two of them: the gate (meters here) holds several stripes, so
-  // it cannot tell whose copy it is and must not merge it into one. It did: on
-  // public_road_noise_0.5 such merges moved the crossing's stripes from 1.0 to 1.5 m off
-  // (marking APE 0.50 -> 0.75 m).
+  // in another frame 1.1 m from the middle one (1.8 m from the first): the gate (meters here)
+  // holds all three, and the copy belongs to the nearest. It went to the first the store
+  // listed: on public_road_noise_0.5 such merges moved the crossing's stripes from 1.0 to
+  // 1.5 m off (marking APE 0.50 -> 0.75 m).
   Rig rig(NoisyOdometryOptions());
   rig.Step(RoadFrame(100.0, 0.0));
   rig.Step(RoadFrame(100.05, 0.5));
   ASSERT_EQ(rig.store.markings().size(), 1u);
   const MarkingElement arrow = rig.store.markings()[0];
+  std::vector<std::uint64_t> stripe_ids;
   for (double y : {4.0, 5.0, 6.0}) {
     rig.store.markings().push_back(Stripe(&rig, arrow, 30.0, y, 0));
+    stripe_ids.push_back(rig.store.markings().back().id);
   }
-  rig.store.markings().push_back(Stripe(&rig, arrow, 30.5, 5.5, 1));
+  rig.store.markings().push_back(Stripe(&rig, arrow, 31.0, 5.45, 1));
   rig.Step(RoadFrame(100.10, 1.0));
-  EXPECT_EQ(rig.counters.markings_merged, 0u);
-  EXPECT_EQ(rig.store.markings().size(), 5u);
+  EXPECT_EQ(rig.counters.markings_merged, 1u);
+  ASSERT_EQ(rig.store.markings().size(), 4u);
+  for (const MarkingElement& m : rig.store.markings()) {
+    if (m.class_id != 11) continue;
+    const bool middle = m.id == stripe_ids[1];
+    EXPECT_EQ(m.history.size(), middle ? 2u : 1u) << "stripe " << m.id;
+  }
 }
 
 TEST(MarkingTracker, RetiredMarkingSeenAgainIsTheSameElement) {

@@ -43,7 +43,7 @@ class MarkingTracker {
   void CheckConsistency(const Ipm& ipm, const FrameRecord& frame);
   // Merges elements of one class closer than association.marking_merge_distance_m, whose
   // rectangles overlap by association.marking_merge_overlap, or within the gate of their
-  // combined uncertainty when no frame saw both and no third element of the class is in it.
+  // combined uncertainty when no frame saw both and each is the other's nearest such element.
   void MergeDuplicates();
 
   const MapperOptions& options_;
