@@ -249,24 +249,50 @@ void MarkingTracker::MergeDuplicates() {
   const double gate2 = o.marking_merge_distance_m * o.marking_merge_distance_m;
   const double floor2 = std::pow(MarkingFloorSigma(o), 2);
   const double sigma_gate2 = o.marking_gate_sigmas * o.marking_gate_sigmas;
-  auto same_marking = [&](const MarkingElement& x, const MarkingElement& y) {
+  std::vector<MarkingElement>& markings = store_->markings();
+  // Squared Mahalanobis distance of two centers under the combined uncertainty of both
+  // elements' best views and the floor.
+  auto gate_distance2 = [&](const MarkingElement& x, const MarkingElement& y) {
     const Eigen::Vector2d d = (x.Center() - y.Center()).head<2>();
-    if (d.squaredNorm() <= gate2) return true;
-    // Re-observed after a gap, or first seen far (IPM meters off): within the gate of the
-    // combined uncertainty of both elements' best views, and never seen in one frame (two
-    // markings side by side are seen together; one marking's two elements never are).
     const Eigen::Matrix2d S =
         x.center_cov_map + y.center_cov_map + floor2 * Eigen::Matrix2d::Identity();
-    if (d.dot(S.ldlt().solve(d)) <= sigma_gate2 && !SeenInOneFrame(x, y)) return true;
+    return d.dot(S.ldlt().solve(d));
+  };
+  // Whether the uncertainty gate may merge x and y: in the gate and never seen in one frame.
+  auto gate_candidates = [&](std::size_t a, std::size_t b) {
+    const MarkingElement& x = markings[a];
+    const MarkingElement& y = markings[b];
+    return a != b && !y.retired && x.class_id == y.class_id &&
+           gate_distance2(x, y) <= sigma_gate2 && !SeenInOneFrame(x, y);
+  };
+  // Whether b is a's nearest gate candidate. The gate grows with the stated odometry noise
+  // (~3 m at 0.5 m), wider than the 1 m spacing of a crossing's stripes: a copy within it of
+  // several stripes belongs to the nearest one, not to whichever the store lists first.
+  auto nearest_candidate = [&](std::size_t a, std::size_t b) {
+    const double d2 = gate_distance2(markings[a], markings[b]);
+    for (std::size_t c = 0; c < markings.size(); ++c) {
+      if (c == b || !gate_candidates(a, c)) continue;
+      if (gate_distance2(markings[a], markings[c]) < d2) return false;
+    }
+    return true;
+  };
+  auto same_marking = [&](std::size_t a, std::size_t b) {
+    const MarkingElement& x = markings[a];
+    const MarkingElement& y = markings[b];
+    const Eigen::Vector2d d = (x.Center() - y.Center()).head<2>();
+    if (d.squaredNorm() <= gate2) return true;
+    // Re-observed after a gap, or first seen far (IPM meters off): within the uncertainty
+    // gate, never seen in one frame (two markings side by side are seen together; one
+    // marking's two elements never are), and each the other's nearest such candidate.
+    if (gate_candidates(a, b) && nearest_candidate(a, b) && nearest_candidate(b, a)) return true;
     if (o.marking_merge_overlap <= 0.0) return false;
     if (d.norm() > Radius(x) + Radius(y)) return false;  // rectangles that cannot touch
     return OverlapOfSmaller(x.corners_map, y.corners_map) >= o.marking_merge_overlap;
   };
-  std::vector<MarkingElement>& markings = store_->markings();
   for (std::size_t a = 0; a < markings.size(); ++a) {
     for (std::size_t b = a + 1; b < markings.size();) {
       if (markings[a].class_id != markings[b].class_id || markings[a].retired ||
-          markings[b].retired || !same_marking(markings[a], markings[b])) {
+          markings[b].retired || !same_marking(a, b)) {
         ++b;
         continue;
       }

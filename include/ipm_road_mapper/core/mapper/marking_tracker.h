@@ -41,8 +41,9 @@ class MarkingTracker {
   // Counts, for each tentative live element, whether this frame should have seen it and
   // whether it did; confirms the consistent ones.
   void CheckConsistency(const Ipm& ipm, const FrameRecord& frame);
-  // Merges elements of one class closer than association.marking_merge_distance_m or whose
-  // rectangles overlap by association.marking_merge_overlap.
+  // Merges elements of one class closer than association.marking_merge_distance_m, whose
+  // rectangles overlap by association.marking_merge_overlap, or within the gate of their
+  // combined uncertainty when no frame saw both and each is the other's nearest such element.
   void MergeDuplicates();
 
   const MapperOptions& options_;
