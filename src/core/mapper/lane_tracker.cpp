@@ -7,6 +7,7 @@
 #include "ipm_road_mapper/core/geometry/ipm.h"
 #include "ipm_road_mapper/core/geometry/lane_end_fit.h"
 #include "ipm_road_mapper/core/geometry/spline_fitting.h"
+#include "ipm_road_mapper/core/mapper/window_coordinator.h"
 
 namespace ipm_road_mapper {
 namespace {
@@ -205,10 +206,17 @@ void LaneTracker::MergeLines() {
       ++counters_->lanes_merged;
     }
   }
-  JoinFragments();
+  JoinFragments(SettledBefore());
 }
 
-void LaneTracker::JoinFragments() {
+std::size_t LaneTracker::SettledBefore() const {
+  const std::size_t frames = store_->frames().size();
+  const BackendOptions& backend = options_.backend;
+  if (!backend.enabled || backend.lane_residual == LaneResidual::kNone) return frames;
+  return LaneContextStart(backend, frames);
+}
+
+void LaneTracker::JoinFragments(std::size_t settled_before_frame) {
   const LaneJoinOptions& join = options_.lanes.join;
   if (!join.enabled) return;
   // Ends farther apart than this cannot be joined (a cheap test before the models).
@@ -221,6 +229,8 @@ void LaneTracker::JoinFragments() {
     for (std::size_t a = 0; a < lanes.size(); ++a) {
       for (std::size_t b = 0; b < lanes.size(); ++b) {
         if (a == b || lanes[a].class_id != lanes[b].class_id) continue;
+        // The junction's data (first's end, second's start) must have left the windows.
+        if (std::max(lanes[a].last_frame, lanes[b].first_frame) >= settled_before_frame) continue;
         const auto& ca = lanes[a].control_points_map;
         const auto& cb = lanes[b].control_points_map;
         if (ca.size() < 4 || cb.size() < 4 ||
