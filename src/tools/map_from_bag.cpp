@@ -264,7 +264,8 @@ std::string Summary(const Arguments& args, const Mapper& mapper, const FrameAsse
     << c.markings_created << " markings, " << c.lanes_created << " lanes; spurious dropped "
     << c.spurious_dropped << ", lanes merged " << c.lanes_merged << ", joined " << c.lanes_joined
     << ", lane observations unused " << c.lane_observations_unused << ", near a lane "
-    << c.lane_observations_near_lane << ")\n"
+    << c.lane_observations_near_lane << ", along a lane of another class "
+    << c.lane_observations_other_class << ")\n"
     << BackendLine(mapper) << "\n"
     << CalibrationLine(mapper) << "\n"
     << FrontEndLine(mapper) << "\n"

@@ -122,6 +122,32 @@ TEST(LaneTracker, AtTheEndOrWithoutLaneResidualJunctionsJoinAtOnce) {
   }
 }
 
+TEST(LaneTracker, AClassFlickeringBetweenDashedAndSolidMakesNoDuplicate) {
+  // One dashed line whose class reads solid (class 1) in every third frame.
+  Rig rig;
+  for (int k = 0; k < 30; ++k) {
+    const FrameInput in = RoadFrame(100.0 + 0.05 * k, 1.0 * k, false);
+    std::optional<Ipm> ipm;
+    FrameObservations obs = rig.Observe(in, TestExtrinsic(), &ipm);
+    ASSERT_EQ(obs.lanes.size(), 1u);
+    if (k % 3 == 1) obs.lanes[0].class_id = 1;
+    const FrameRecord& frame = rig.store.AddFrame(in.stamp, in.T_map_base_odom);
+    rig.tracker.Update(obs.lanes, frame);
+    rig.tracker.DropSpurious(frame.index);
+  }
+  ASSERT_EQ(rig.store.lanes().size(), 1u);
+  EXPECT_EQ(rig.store.lanes()[0].class_id, 2);
+  EXPECT_GE(rig.counters.lane_observations_other_class, 9u);
+  // A line that goes on in another class past the lane's end still starts a lane.
+  const FrameInput ahead = RoadFrame(102.0, 80.0, false);
+  std::optional<Ipm> ipm;
+  FrameObservations obs = rig.Observe(ahead, TestExtrinsic(), &ipm);
+  ASSERT_EQ(obs.lanes.size(), 1u);
+  obs.lanes[0].class_id = 1;
+  rig.tracker.Update(obs.lanes, rig.store.AddFrame(ahead.stamp, ahead.T_map_base_odom));
+  EXPECT_EQ(rig.store.lanes().size(), 2u);
+}
+
 TEST(LaneTracker, ShortUnmatchedPieceStartsNoLane) {
   Rig rig;
   FrameInput in = RoadFrame(100.0, 0.0, false);

@@ -126,6 +126,19 @@ void LaneTracker::Start(int class_id, const LaneMeasurement& measurement,
       return;
     }
   }
+  // Along a mapped stretch of a lane of another class (a class flickering between solid and
+  // dashed): the same line, not a new one. Only points beside the lane's curve count, not
+  // past its ends: a line that goes on in another class still starts there.
+  AssociationOptions alongside = loose;
+  alongside.lane_max_end_gap_m = 0.0;
+  for (const LaneElement& lane : store_->lanes()) {
+    if (lane.class_id == class_id) continue;
+    const LaneCandidate as_its_class{lane.class_id, usable_map, {}, {}};
+    if (LaneAssociationCost(lane, as_its_class, alongside) >= 0.0) {
+      ++counters_->lane_observations_other_class;
+      return;
+    }
+  }
   auto control_points = EstimateControlPoints(measurement.selected_map, options_.lanes.fit);
   if (!control_points) control_points = EstimateControlPoints(usable_map, options_.lanes.fit);
   if (!control_points) {

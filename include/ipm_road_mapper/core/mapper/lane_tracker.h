@@ -47,7 +47,8 @@ class LaneTracker {
                                                   const Eigen::Isometry3d& T_base_cam) const;
 
  private:
-  // Starts a lane unless the observation is short or near a lane (loose gates).
+  // Starts a lane unless the observation is short, near a lane (loose gates) or along a
+  // mapped lane of another class.
   void Start(int class_id, const LaneMeasurement& measurement,
              const std::vector<Eigen::Vector3d>& usable_map, const FrameRecord& frame);
   // Grows the lane's ends with this frame's usable points and refines them with the
