@@ -128,8 +128,9 @@ void LaneTracker::Start(int class_id, const LaneMeasurement& measurement,
   }
   // Along a mapped stretch of a lane of another class (a class flickering between solid and
   // dashed): the same line, not a new one. Only points beside the lane's curve count, not
-  // past its ends: a line that goes on in another class still starts there.
-  AssociationOptions alongside = loose;
+  // past its ends: a line that goes on in another class still starts there. The plain gates:
+  // at 0.5 m of odometry noise the loose ones reach the next lane's line, 3.5 m beside.
+  AssociationOptions alongside = options_.association;
   alongside.lane_max_end_gap_m = 0.0;
   for (const LaneElement& lane : store_->lanes()) {
     if (lane.class_id == class_id) continue;
