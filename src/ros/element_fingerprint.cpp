@@ -60,6 +60,11 @@ std::size_t FieldsFingerprint(const MapLane& lane) {
   HashClass(&seed, lane.class_id, lane.class_name);
   HashCombine(&seed, std::hash<std::string>()(lane.style));
   HashLife(&seed, lane.observations, lane.first_seen, lane.last_seen);
+  // The topology: a new link re-sends the lane's fields (its patch carries the links).
+  for (const auto* ids : {&lane.predecessors, &lane.successors}) {
+    HashCombine(&seed, ids->size());
+    for (const std::uint64_t id : *ids) HashCombine(&seed, std::hash<std::uint64_t>()(id));
+  }
   return seed;
 }
 

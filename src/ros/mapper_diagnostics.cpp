@@ -66,6 +66,13 @@ void FillFrameStatus(const MapperStatusSnapshot& now, const MapperStatusSnapshot
   s->add("odometry bad", now.assembler.bad_odometry);
   s->add("odometry out of order", now.assembler.odometry_out_of_order);
   s->add("time jumps", now.assembler.time_jumps);
+  // Bad lane input, by reason (docs/architecture.md, "Bad input").
+  const ExtractionCounters& e = now.counters.extraction;
+  s->add("lanes dropped: wider than a line", e.dropped_wide_lane);
+  s->add("lanes dropped: doubling back", e.dropped_doubled_lane);
+  s->add("lane rows crossing their instance twice", e.lane_rows_doubled);
+  s->add("lane observations along a lane of another class (class flicker)",
+         now.counters.lane_observations_other_class);
   s->addf("callback time mean (ms)", "%.3f", now.callback_mean_ms);
   s->addf("callback time max (ms)", "%.3f", now.callback_max_ms);
   s->addf("frame callback time mean (ms)", "%.3f", now.frame_callback_mean_ms);

@@ -41,6 +41,8 @@ ipm_road_mapper::LaneSpline ToLaneMsg(const MapLane& lane) {
   l.observations = lane.observations;
   l.first_seen = SafeTime(lane.first_seen);
   l.last_seen = SafeTime(lane.last_seen);
+  l.predecessors = lane.predecessors;
+  l.successors = lane.successors;
   return l;
 }
 
@@ -85,6 +87,8 @@ VectorMap FromVectorMapMsg(const ipm_road_mapper::VectorMapMsg& msg) {
     lane.observations = l.observations;
     lane.first_seen = ToSeconds(l.first_seen);
     lane.last_seen = ToSeconds(l.last_seen);
+    lane.predecessors = l.predecessors;
+    lane.successors = l.successors;
     map.lanes.push_back(lane);
   }
   Eigen::Isometry3d T = Eigen::Isometry3d::Identity();

@@ -43,6 +43,8 @@ ipm_road_mapper::LaneSplinePatch Patch(const MapLane& lane, std::size_t first) {
   patch.observations = whole.observations;
   patch.first_seen = whole.first_seen;
   patch.last_seen = whole.last_seen;
+  patch.predecessors = whole.predecessors;
+  patch.successors = whole.successors;
   return patch;
 }
 
@@ -196,6 +198,8 @@ void ApplyVectorMapDelta(const ipm_road_mapper::VectorMapDelta& delta, VectorMap
     lane.observations = patch.observations;
     lane.first_seen = ToSeconds(patch.first_seen);
     lane.last_seen = ToSeconds(patch.last_seen);
+    lane.predecessors = patch.predecessors;
+    lane.successors = patch.successors;
   }
   Eigen::Isometry3d T = Eigen::Isometry3d::Identity();
   if (TransformToIsometry(delta.base_to_camera, &T).empty()) map->T_base_cam = T;

@@ -262,15 +262,17 @@ std::string Summary(const Arguments& args, const Mapper& mapper, const FrameAsse
     << ", instance limit " << e.dropped_instance_limit << "; partial markings kept "
     << e.partial_markings << "\n"
     << "implausible: " << e.dropped_oversized << " oversized markings, " << e.dropped_wide_lane
-    << " wide lanes (" << e.lane_runs_too_wide
-    << " lane runs too wide), frames without observations: " << e.frames_too_many_instances
+    << " wide lanes (" << e.lane_runs_too_wide << " lane runs too wide), " << e.dropped_doubled_lane
+    << " lanes doubling back (" << e.lane_rows_doubled
+    << " lane rows of several runs), frames without observations: " << e.frames_too_many_instances
     << " too many instances, " << e.frames_too_much_coverage << " too much coverage ("
     << e.dropped_absurd_frame << " instances); odometry reordered " << a.odometry_reordered << "\n"
     << "map: " << map.markings.size() << " markings, " << map.lanes.size() << " lanes (created "
     << c.markings_created << " markings, " << c.lanes_created << " lanes; spurious dropped "
     << c.spurious_dropped << ", lanes merged " << c.lanes_merged << ", joined " << c.lanes_joined
     << ", lane observations unused " << c.lane_observations_unused << ", near a lane "
-    << c.lane_observations_near_lane << ")\n"
+    << c.lane_observations_near_lane << ", along a lane of another class "
+    << c.lane_observations_other_class << ")\n"
     << BackendLine(mapper) << "\n"
     << CalibrationLine(mapper) << "\n"
     << FrontEndLine(mapper) << "\n"

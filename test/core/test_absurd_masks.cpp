@@ -4,6 +4,7 @@
 // pose is still used.
 #include <gtest/gtest.h>
 
+#include <cmath>
 #include <cstdint>
 #include <opencv2/imgproc.hpp>
 #include <string>
@@ -92,6 +93,39 @@ TEST_F(AbsurdMasksTest, WholeImageLaneInstance) {
   ExpectNothing(lane);
   EXPECT_EQ(lane.counters.dropped_wide_lane, 1u);
   EXPECT_GT(lane.counters.lane_runs_too_wide, 50u);
+}
+
+TEST_F(AbsurdMasksTest, LaneDoublingBackIsDropped) {
+  // One instance running out along y = 1.8 m, turning at 30 m and coming back along y = 3.0 m
+  // (a U): most rows cross it twice, and which arm is the line is unknown.
+  cv::Mat mask = GroundMask(4.0, 30.0, 1.725, 1.875, kSolidLane + 1);
+  FillGround(Rect(29.7, 30.0, 1.725, 3.075), PoseAt(0.0), kSolidLane + 1, &mask);
+  FillGround(Rect(4.0, 30.0, 2.925, 3.075), PoseAt(0.0), kSolidLane + 1, &mask);
+  const FrameObservations obs = Extract(mask);
+  ExpectNothing(obs);
+  EXPECT_EQ(obs.counters.dropped_doubled_lane, 1u);
+  EXPECT_GT(obs.counters.lane_rows_doubled, 20u);
+  // A short second arm (a fork's first meters): kept, its rows counted.
+  cv::Mat fork = GroundMask(4.0, 30.0, 1.725, 1.875, kSolidLane + 1);
+  FillGround(Rect(27.0, 30.0, 2.1, 2.25), PoseAt(0.0), kSolidLane + 1, &fork);
+  const FrameObservations kept = Extract(fork);
+  ASSERT_EQ(kept.lanes.size(), 1u);
+  EXPECT_EQ(kept.counters.dropped_doubled_lane, 0u);
+  EXPECT_GT(kept.counters.lane_rows_doubled, 0u);
+  // A plain line has no doubled row.
+  EXPECT_EQ(Extract(GroundMask(4.0, 30.0, 1.725, 1.875, kSolidLane + 1)).counters.lane_rows_doubled,
+            0u);
+}
+
+TEST_F(AbsurdMasksTest, LaneCoveringHalfTheImage) {
+  // The left half of the image as one lane instance: under the frame's coverage bound, but
+  // every row's run is meters wide on the ground.
+  cv::Mat mask = EmptyMask();
+  mask(cv::Rect(0, 0, 640, 720)).setTo(cv::Scalar(kSolidLane + 1));
+  const FrameObservations obs = Extract(mask);
+  ExpectNothing(obs);
+  EXPECT_EQ(obs.counters.frames_too_much_coverage, 0u);
+  EXPECT_EQ(obs.counters.dropped_wide_lane, 1u);
 }
 
 TEST_F(AbsurdMasksTest, WholeImageMarking) {
@@ -293,6 +327,32 @@ TEST(AbsurdFramesInTheMapper, BadMarkingInstancesAreCountedAndLeaveTheMap) {
   const VectorMap exported = mapper.ExportMap(ExportOptions());
   ASSERT_EQ(exported.markings.size(), 1u);
   EXPECT_EQ(exported.markings[0].id, id);
+}
+
+TEST(AbsurdFramesInTheMapper, LaneDoublingBackOrCoveringHalfTheImageMakesNoDuplicate) {
+  // The dashed line of the road frames, with (in every other frame) its instance continued
+  // by an arm coming back 1.2 m beside it, or the left half of the image painted with it:
+  // one lane, on the line, and both counted.
+  Mapper mapper = MakeMapper();
+  for (int k = 0; k < 30; ++k) {
+    const double x = 0.5 * k;
+    FrameInput in = test::RoadFrame(100.0 + 0.05 * k, x, false);
+    if (k % 4 == 1) {
+      FillGround(Rect(x + 4.0, x + 30.0, 2.925, 3.075), in.T_map_base_odom, 2001, &in.mask);
+      FillGround(Rect(x + 29.7, x + 30.0, 1.725, 3.075), in.T_map_base_odom, 2001, &in.mask);
+    } else if (k % 4 == 3) {
+      in.mask(cv::Rect(0, 0, 640, 720)).setTo(cv::Scalar(2001));
+    }
+    ASSERT_EQ(mapper.ProcessFrame(in), FrameStatus::kUsed);
+  }
+  const ExtractionCounters& c = mapper.counters().extraction;
+  EXPECT_GE(c.dropped_doubled_lane, 7u);
+  EXPECT_GE(c.dropped_wide_lane, 7u);
+  const VectorMap map = mapper.ExportMap(ExportOptions());
+  ASSERT_EQ(map.lanes.size(), 1u);
+  for (std::size_t i = 1; i + 1 < map.lanes[0].control_points_map.size(); ++i) {
+    EXPECT_NEAR(map.lanes[0].control_points_map[i].y(), 1.8, 0.3);
+  }
 }
 
 // The error message of loading `yaml` as the `extraction` section.

@@ -3,6 +3,7 @@
 // lanes along one line are merged, and the export re-fit follows a changed extrinsic.
 #include <gtest/gtest.h>
 
+#include "common/lane_fragments.h"
 #include "common/road_scene.h"
 #include "ipm_road_mapper/core/frontend/instance_extraction.h"
 #include "ipm_road_mapper/core/mapper/lane_tracker.h"
@@ -62,6 +63,89 @@ TEST(LaneTracker, TwoLanesAlongOneLineAreMerged) {
   EXPECT_EQ(rig.store.lanes().size(), 1u);
   EXPECT_EQ(rig.counters.lanes_merged, 1u);
   EXPECT_EQ(rig.store.lanes()[0].history.size(), 3u);  // both histories and the new frame
+}
+
+// Two fragments of one dashed line across a gap: lane 1 seen in frames 0-39, lane 2 from
+// frame 60 on.
+void AddFragments(Rig* rig) {
+  std::mt19937 rng(7);
+  const test::Line line = test::Straight(1.75);
+  rig->store.lanes().push_back(test::MakeLane(rig->store.NewId(), 2, line, 0.0, 40.0, 0, 40, &rng));
+  rig->store.lanes().push_back(
+      test::MakeLane(rig->store.NewId(), 2, line, 46.0, 100.0, 60, 120, &rng));
+}
+
+// Frames along x until the store holds `frames`.
+void AddFrames(Rig* rig, std::size_t frames) {
+  while (rig->store.frames().size() < frames) {
+    const double x = static_cast<double>(rig->store.frames().size());
+    Eigen::Isometry3d T_map_base = Eigen::Isometry3d::Identity();
+    T_map_base.translation().x() = x;
+    rig->store.AddFrame(0.05 * x, T_map_base);
+  }
+}
+
+TEST(LaneTracker, AJunctionIsJoinedOnlineOnceItsDataLeftTheWindows) {
+  MapperOptions options;  // back end with PPSR, window of 40 frames: lane context 80 frames
+  ASSERT_TRUE(options.lanes.join.enabled);
+  Rig rig(options);
+  AddFragments(&rig);
+  AddFrames(&rig, 140);
+  // Frame 60 (lane 2's first) is still in the windows' lane context (from frame 60 on).
+  EXPECT_EQ(rig.tracker.SettledBefore(), 60u);
+  rig.tracker.JoinFragments(rig.tracker.SettledBefore());
+  EXPECT_EQ(rig.store.lanes().size(), 2u);
+  EXPECT_EQ(rig.counters.lanes_joined, 0u);
+  AddFrames(&rig, 141);  // now it has left: joined
+  rig.tracker.JoinFragments(rig.tracker.SettledBefore());
+  ASSERT_EQ(rig.store.lanes().size(), 1u);
+  EXPECT_EQ(rig.counters.lanes_joined, 1u);
+  EXPECT_EQ(rig.store.lanes()[0].history.size(), 100u);
+}
+
+TEST(LaneTracker, AtTheEndOrWithoutLaneResidualJunctionsJoinAtOnce) {
+  Rig at_end;
+  AddFragments(&at_end);
+  AddFrames(&at_end, 125);
+  at_end.tracker.JoinFragments();  // the end of the drive: everything is settled
+  EXPECT_EQ(at_end.store.lanes().size(), 1u);
+  for (const bool backend_enabled : {false, true}) {
+    MapperOptions options;
+    options.backend.enabled = backend_enabled;
+    options.backend.lane_residual = LaneResidual::kNone;  // no window uses lane data
+    Rig rig(options);
+    AddFragments(&rig);
+    AddFrames(&rig, 125);
+    EXPECT_EQ(rig.tracker.SettledBefore(), 125u);
+    rig.tracker.JoinFragments(rig.tracker.SettledBefore());
+    EXPECT_EQ(rig.store.lanes().size(), 1u) << backend_enabled;
+  }
+}
+
+TEST(LaneTracker, AClassFlickeringBetweenDashedAndSolidMakesNoDuplicate) {
+  // One dashed line whose class reads solid (class 1) in every third frame.
+  Rig rig;
+  for (int k = 0; k < 30; ++k) {
+    const FrameInput in = RoadFrame(100.0 + 0.05 * k, 1.0 * k, false);
+    std::optional<Ipm> ipm;
+    FrameObservations obs = rig.Observe(in, TestExtrinsic(), &ipm);
+    ASSERT_EQ(obs.lanes.size(), 1u);
+    if (k % 3 == 1) obs.lanes[0].class_id = 1;
+    const FrameRecord& frame = rig.store.AddFrame(in.stamp, in.T_map_base_odom);
+    rig.tracker.Update(obs.lanes, frame);
+    rig.tracker.DropSpurious(frame.index);
+  }
+  ASSERT_EQ(rig.store.lanes().size(), 1u);
+  EXPECT_EQ(rig.store.lanes()[0].class_id, 2);
+  EXPECT_GE(rig.counters.lane_observations_other_class, 9u);
+  // A line that goes on in another class past the lane's end still starts a lane.
+  const FrameInput ahead = RoadFrame(102.0, 80.0, false);
+  std::optional<Ipm> ipm;
+  FrameObservations obs = rig.Observe(ahead, TestExtrinsic(), &ipm);
+  ASSERT_EQ(obs.lanes.size(), 1u);
+  obs.lanes[0].class_id = 1;
+  rig.tracker.Update(obs.lanes, rig.store.AddFrame(ahead.stamp, ahead.T_map_base_odom));
+  EXPECT_EQ(rig.store.lanes().size(), 2u);
 }
 
 TEST(LaneTracker, ShortUnmatchedPieceStartsNoLane) {

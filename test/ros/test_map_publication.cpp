@@ -118,6 +118,8 @@ void ExpectSameMap(const VectorMap& a, const VectorMap& b) {
     }
     EXPECT_EQ(it->style, l.style);
     EXPECT_EQ(it->observations, l.observations);
+    EXPECT_EQ(it->predecessors, l.predecessors) << l.id;
+    EXPECT_EQ(it->successors, l.successors) << l.id;
   }
 }
 
@@ -155,6 +157,16 @@ TEST(VectorMapDelta, AClientRebuildsTheMapFromTheDeltas) {
   EXPECT_EQ(delta.removed_marking_ids, (std::vector<std::uint64_t>{103}));
   ApplyVectorMapDelta(delta, &client);
   ExpectSameMap(map, client);
+  // Only the topology changes (lane 2 continues lane 1): both lanes are sent, no point.
+  map.lanes[0].successors = {2};
+  map.lanes[1].predecessors = {1};
+  delta = builder.Build(map, "map", ros::Time(3.5));
+  ASSERT_EQ(delta.lanes.size(), 2u);
+  EXPECT_TRUE(delta.lanes[0].control_points.empty());
+  EXPECT_EQ(delta.lanes[0].successors, (std::vector<std::uint64_t>{2}));
+  EXPECT_EQ(delta.lanes[1].predecessors, (std::vector<std::uint64_t>{1}));
+  ApplyVectorMapDelta(delta, &client);
+  ExpectSameMap(map, client);
   // A lane shrinks (re-fit) and another leaves the map.
   map.lanes[0].control_points_map.resize(30);
   map.lanes.erase(map.lanes.begin() + 1);
@@ -168,7 +180,7 @@ TEST(VectorMapDelta, AClientRebuildsTheMapFromTheDeltas) {
   // ~reset.
   delta = builder.Clear("map", ros::Time(5.0));
   EXPECT_TRUE(delta.reset);
-  EXPECT_EQ(delta.sequence, 5u);
+  EXPECT_EQ(delta.sequence, 6u);  // five deltas before it (the topology one included)
   ApplyVectorMapDelta(delta, &client);
   EXPECT_TRUE(client.markings.empty() && client.lanes.empty());
 }

@@ -85,6 +85,13 @@ TEST(MapperDiagnostics, BeforeStartTheSessionCountsAreShown) {
   DiagnosticStatusWrapper s;
   FillFrameStatus(now, MapperStatusSnapshot(), Flowing(), &s);
   EXPECT_EQ(Value(s, "skipped: no_extrinsic"), "7");
+  EXPECT_EQ(Value(s, "lanes dropped: doubling back"), "0");
+  now.counters.extraction.dropped_doubled_lane = 2;
+  now.counters.extraction.dropped_wide_lane = 3;
+  DiagnosticStatusWrapper bad_lanes;
+  FillFrameStatus(now, MapperStatusSnapshot(), Flowing(), &bad_lanes);
+  EXPECT_EQ(Value(bad_lanes, "lanes dropped: doubling back"), "2");
+  EXPECT_EQ(Value(bad_lanes, "lanes dropped: wider than a line"), "3");
   EXPECT_EQ(s.level, DiagnosticStatus::WARN);
   DiagnosticStatusWrapper e;
   now.extrinsic_status = "no extrinsic base_link -> cam: frame does not exist";

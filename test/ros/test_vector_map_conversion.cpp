@@ -34,6 +34,8 @@ VectorMap SomeMap() {
   lane.observations = 9;
   lane.first_seen = 1000.0;
   lane.last_seen = 1002.0;
+  lane.predecessors = {2};
+  lane.successors = {7, 9};  // a fork
   map.lanes.push_back(lane);
   map.T_base_cam.linear() = RotationFromRpy(-1.6, 0.05, -1.55);
   map.T_base_cam.translation() = Eigen::Vector3d(1.5, 0.02, 1.45);
@@ -80,6 +82,9 @@ TEST(VectorMapConversion, RoundTripKeepsEveryField) {
   EXPECT_EQ(back.lanes[0].style, "solid");
   EXPECT_EQ(back.lanes[0].control_points_map.size(), 6u);
   EXPECT_TRUE(back.lanes[0].control_points_map[5].isApprox(map.lanes[0].control_points_map[5]));
+  EXPECT_EQ(msg.lanes[0].successors, (std::vector<std::uint64_t>{7, 9}));
+  EXPECT_EQ(back.lanes[0].predecessors, (std::vector<std::uint64_t>{2}));
+  EXPECT_EQ(back.lanes[0].successors, (std::vector<std::uint64_t>{7, 9}));
   EXPECT_TRUE(back.T_base_cam.isApprox(map.T_base_cam, 1e-9));
 }
 

@@ -27,7 +27,8 @@ std::size_t GeometryFingerprint(const MapLane& lane, std::size_t first, std::siz
 std::size_t MessageFingerprint(const MapMarking& marking);
 std::size_t MessageFingerprint(const MapLane& lane);
 
-// A lane's message fields other than its control points (class, style, observations, stamps).
+// A lane's message fields other than its control points (class, style, observations, stamps,
+// predecessor and successor ids).
 std::size_t FieldsFingerprint(const MapLane& lane);
 
 }  // namespace ipm_road_mapper

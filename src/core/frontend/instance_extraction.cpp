@@ -241,8 +241,9 @@ FrameObservations ExtractObservations(const cv::Mat& mask, const ClassTable& cla
       lane.class_id = ClassIdOf(stats.value);
       lane.instance_value = stats.value;
       lane.pixel_count = stats.pixel_count;
-      outcome = extraction::ExtractLane(runs, stats.run_count, class_info, ipm, error_model,
-                                        options, &lane, &counters.lane_runs_too_wide);
+      outcome =
+          extraction::ExtractLane(runs, stats.run_count, class_info, ipm, error_model, options,
+                                  &lane, &counters.lane_runs_too_wide, &counters.lane_rows_doubled);
       if (outcome == GeometryOutcome::kOk) observations.lanes.push_back(std::move(lane));
     } else {
       MarkingObservation marking;
@@ -260,6 +261,7 @@ FrameObservations ExtractObservations(const cv::Mat& mask, const ClassTable& cla
     if (outcome == GeometryOutcome::kDegenerate) ++counters.dropped_degenerate;
     if (outcome == GeometryOutcome::kOversized) ++counters.dropped_oversized;
     if (outcome == GeometryOutcome::kTooWide) ++counters.dropped_wide_lane;
+    if (outcome == GeometryOutcome::kDoublesBack) ++counters.dropped_doubled_lane;
     if (outcome == GeometryOutcome::kTruncated) ++counters.dropped_border;
   }
   return observations;

@@ -262,7 +262,7 @@ GeometryOutcome ExtractMarking(const Run* runs, int run_count, const cv::Mat& ma
 GeometryOutcome ExtractLane(const Run* runs, int run_count, const ClassInfo& class_info,
                             const Ipm& ipm, const IpmErrorModel& error_model,
                             const ExtractionOptions& options, LaneObservation* lane,
-                            std::uint64_t* runs_too_wide) {
+                            std::uint64_t* runs_too_wide, std::uint64_t* rows_doubled) {
   if (run_count <= 0) return GeometryOutcome::kDegenerate;
   const int row_step = std::max(options.lane_row_step, 1);
   const int bottom_row = runs[run_count - 1].row;
@@ -271,6 +271,8 @@ GeometryOutcome ExtractLane(const Run* runs, int run_count, const ClassInfo& cla
   const int last_col = ipm.camera().intrinsics().width - 1 - margin;
   // Runs whose ground width was measured, and those of them too wide for a line.
   int runs_measured = 0, runs_wide = 0;
+  // Sampled rows, and those that cross the instance more than once.
+  int rows_sampled = 0, rows_several = 0;
   // Rows bottom (near) first; within a row, runs left to right.
   int end = run_count;
   while (end > 0) {
@@ -278,6 +280,8 @@ GeometryOutcome ExtractLane(const Run* runs, int run_count, const ClassInfo& cla
     int begin = end - 1;
     while (begin > 0 && runs[begin - 1].row == row) --begin;
     if ((bottom_row - row) % row_step == 0) {
+      ++rows_sampled;
+      if (end - begin > 1) ++rows_several;
       for (int i = begin; i < end; ++i) {
         const Eigen::Vector2d uv(0.5 * (runs[i].first_col + runs[i].last_col), row);
         LanePoint point;
@@ -305,7 +309,9 @@ GeometryOutcome ExtractLane(const Run* runs, int run_count, const ClassInfo& cla
     end = begin;
   }
   *runs_too_wide += runs_wide;
+  *rows_doubled += static_cast<std::uint64_t>(rows_several);
   if (2 * runs_wide > runs_measured) return GeometryOutcome::kTooWide;
+  if (4 * rows_several > rows_sampled) return GeometryOutcome::kDoublesBack;
   return static_cast<int>(lane->points.size()) >= options.min_lane_points
              ? GeometryOutcome::kOk
              : GeometryOutcome::kDegenerate;

@@ -49,7 +49,15 @@ struct MaskRuns {
 MaskRuns ScanMask(const cv::Mat& mask);
 
 // Why the geometry of one instance was rejected.
-enum class GeometryOutcome { kOk, kRange, kDegenerate, kOversized, kTooWide, kTruncated };
+enum class GeometryOutcome {
+  kOk,
+  kRange,
+  kDegenerate,
+  kOversized,
+  kTooWide,
+  kTruncated,
+  kDoublesBack
+};
 
 // Marking rectangle from the runs of one instance `value` of `mask` (row-major). The
 // outline is the sub-pixel convex outline of the instance's significant 8-connected pieces
@@ -73,12 +81,16 @@ GeometryOutcome ExtractMarking(const Run* runs, int run_count, const cv::Mat& ma
 // two outer pixel edges) exceeds class_info.max_width_m plus the IPM uncertainty at its
 // center (sqrt of the score) is no line: it gives no point and is added to
 // *runs_too_wide; checked before the side cut, since a cut run is at least that wide.
+// Rows that cross the instance more than once (two dashes of a curve in one row, a hole,
+// a fork) are added to *rows_doubled; kDoublesBack when they are more than a quarter of the
+// sampled rows: the instance is two lines (or one turned back on itself), and which of them
+// is the line is unknown (a point of each would make a zigzag of both).
 // kTooWide when more than half of the runs measured are too wide; kDegenerate when fewer
 // than options.min_lane_points survive the IPM.
 GeometryOutcome ExtractLane(const Run* runs, int run_count, const ClassInfo& class_info,
                             const Ipm& ipm, const IpmErrorModel& error_model,
                             const ExtractionOptions& options, LaneObservation* lane,
-                            std::uint64_t* runs_too_wide);
+                            std::uint64_t* runs_too_wide, std::uint64_t* rows_doubled);
 
 // Ground width (m, x-y in base_link) of a run: the distance between the IPM of its outer
 // pixel edges (first_col - 0.5 and last_col + 0.5 on its row); nullopt when an edge does

@@ -13,6 +13,8 @@ void ExtractionCounters::Add(const ExtractionCounters& o) {
   dropped_instance_limit += o.dropped_instance_limit;
   dropped_oversized += o.dropped_oversized;
   dropped_wide_lane += o.dropped_wide_lane;
+  dropped_doubled_lane += o.dropped_doubled_lane;
+  lane_rows_doubled += o.lane_rows_doubled;
   dropped_absurd_frame += o.dropped_absurd_frame;
   lane_runs_too_wide += o.lane_runs_too_wide;
   frames_too_many_instances += o.frames_too_many_instances;

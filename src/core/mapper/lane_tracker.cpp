@@ -7,6 +7,7 @@
 #include "ipm_road_mapper/core/geometry/ipm.h"
 #include "ipm_road_mapper/core/geometry/lane_end_fit.h"
 #include "ipm_road_mapper/core/geometry/spline_fitting.h"
+#include "ipm_road_mapper/core/mapper/window_coordinator.h"
 
 namespace ipm_road_mapper {
 namespace {
@@ -126,6 +127,20 @@ void LaneTracker::Start(int class_id, const LaneMeasurement& measurement,
       return;
     }
   }
+  // Along a mapped stretch of a lane of another class (a class flickering between solid and
+  // dashed): the same line, not a new one. Only points beside the lane's curve count, not
+  // past its ends: a line that goes on in another class still starts there. The plain gates:
+  // at 0.5 m of odometry noise the loose ones reach the next lane's line, 3.5 m beside.
+  AssociationOptions alongside = options_.association;
+  alongside.lane_max_end_gap_m = 0.0;
+  for (const LaneElement& lane : store_->lanes()) {
+    if (lane.class_id == class_id) continue;
+    const LaneCandidate as_its_class{lane.class_id, usable_map, {}, {}};
+    if (LaneAssociationCost(lane, as_its_class, alongside) >= 0.0) {
+      ++counters_->lane_observations_other_class;
+      return;
+    }
+  }
   auto control_points = EstimateControlPoints(measurement.selected_map, options_.lanes.fit);
   if (!control_points) control_points = EstimateControlPoints(usable_map, options_.lanes.fit);
   if (!control_points) {
@@ -208,10 +223,17 @@ void LaneTracker::MergeLines() {
       ++counters_->lanes_merged;
     }
   }
-  JoinFragments();
+  JoinFragments(SettledBefore());
 }
 
-void LaneTracker::JoinFragments() {
+std::size_t LaneTracker::SettledBefore() const {
+  const std::size_t frames = store_->frames().size();
+  const BackendOptions& backend = options_.backend;
+  if (!backend.enabled || backend.lane_residual == LaneResidual::kNone) return frames;
+  return LaneContextStart(backend, frames);
+}
+
+void LaneTracker::JoinFragments(std::size_t settled_before_frame) {
   const LaneJoinOptions& join = options_.lanes.join;
   if (!join.enabled) return;
   // Ends farther apart than this cannot be joined (a cheap test before the models).
@@ -224,6 +246,8 @@ void LaneTracker::JoinFragments() {
     for (std::size_t a = 0; a < lanes.size(); ++a) {
       for (std::size_t b = 0; b < lanes.size(); ++b) {
         if (a == b || lanes[a].class_id != lanes[b].class_id) continue;
+        // The junction's data (first's end, second's start) must have left the windows.
+        if (std::max(lanes[a].last_frame, lanes[b].first_frame) >= settled_before_frame) continue;
         const auto& ca = lanes[a].control_points_map;
         const auto& cb = lanes[b].control_points_map;
         if (ca.size() < 4 || cb.size() < 4 ||

@@ -61,6 +61,12 @@ void SliceForWindow(const LaneElement& lane, const std::vector<const LaneMeasure
 
 }  // namespace
 
+std::size_t LaneContextStart(const BackendOptions& options, std::size_t frame_count) {
+  const std::size_t window = static_cast<std::size_t>(options.window_frames);
+  const std::size_t first = frame_count > window ? frame_count - window : 0;
+  return first > window ? first - window : 0;
+}
+
 WindowCoordinator::WindowCoordinator(const MapperOptions& options,
                                      const Eigen::Isometry3d& T_base_cam_initial, MapStore* store,
                                      MapperCounters* counters)
@@ -264,10 +270,9 @@ void WindowCoordinator::FinalGlobalSolve(double time_budget_s) {
 
 WindowSnapshot WindowCoordinator::BuildSnapshot() {
   const std::vector<FrameRecord>& frames = store_->frames();
-  const std::size_t window = static_cast<std::size_t>(options_.backend.window_frames);
   const std::size_t first = WindowStart();
   // Lanes keep the pixels of one more window of frames as context; older ones retire.
-  const std::size_t lane_first = first > window ? first - window : 0;
+  const std::size_t lane_first = LaneContextStart(options_.backend, frames.size());
   for (MarkingElement& m : store_->markings()) {
     if (!m.retired && m.last_frame < first && m.optimized) RetireMarking(&m);
     if (!m.retired && m.last_frame < first) m.retired = true;  // never reached the back end

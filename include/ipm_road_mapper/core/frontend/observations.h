@@ -82,6 +82,10 @@ struct ExtractionCounters {
   std::uint64_t lane_runs_too_wide = 0;         // lane runs (points) wider than a line: no point
   std::uint64_t frames_too_many_instances = 0;  // frames over max_plausible_instances
   std::uint64_t frames_too_much_coverage = 0;   // frames over max_coverage
+  // Lane rows (sampled) that cross their instance more than once; and lane instances with
+  // more than a quarter of such rows (one that doubles back): dropped.
+  std::uint64_t lane_rows_doubled = 0;
+  std::uint64_t dropped_doubled_lane = 0;
   void Add(const ExtractionCounters& o);
 };
 

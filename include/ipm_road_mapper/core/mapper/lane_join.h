@@ -18,10 +18,9 @@ namespace ipm_road_mapper {
 
 // Gates of the join (config section `lanes`, keys join_*).
 struct LaneJoinOptions {
-  // Off by default: joining makes one spline per line, but on public_road it moves the
-  // extrinsic and every lane 2 cm, and on noisy odometry it damages the markings
-  // (docs/backend.md, "Joining fragments").
-  bool enabled = false;
+  // On by default: one spline per painted line. Online, a junction is joined once its data
+  // has left the windows (LaneTracker::JoinFragments; docs/backend.md, "Joining fragments").
+  bool enabled = true;
   double max_gap_m = 20.0;      // longest gap between A's last data and B's first
   double max_overlap_m = 10.0;  // longest stretch where both have data
   double end_length_m = 20.0;   // each end is modelled by its data within this length

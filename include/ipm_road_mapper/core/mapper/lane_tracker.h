@@ -6,6 +6,7 @@
 
 #include <Eigen/Geometry>
 #include <cstddef>
+#include <limits>
 #include <vector>
 
 #include "ipm_road_mapper/core/frontend/observations.h"
@@ -29,8 +30,15 @@ class LaneTracker {
   // association.spurious_after_frames frames.
   void DropSpurious(std::size_t frame_index);
   // Joins the lanes that continue one another (LaneContinues), until none does; runs with
-  // the merge and at the end of the drive.
-  void JoinFragments();
+  // the merge and at the end of the drive. Online only junctions whose data (the first's
+  // last and the second's first observation) is older than `settled_before_frame`: a join
+  // inside the windows ties the data on both sides of a gap with the bridge's smoothness
+  // while the windows still solve the poses and extrinsic around it, which moved the
+  // extrinsic's lateral lever arm by 2 cm on public_road (docs/backend.md).
+  void JoinFragments(std::size_t settled_before_frame = std::numeric_limits<std::size_t>::max());
+  // The frame before which lane data is settled: LaneContextStart when a lane residual
+  // refines lanes in the windows, else the frame count (no window uses lane data).
+  std::size_t SettledBefore() const;
 
   // The lane's control points re-fit to all its selected pixels, IPMed with `T_base_cam`
   // and the frames' current poses (export of lanes no lane residual refines).
@@ -39,7 +47,8 @@ class LaneTracker {
                                                   const Eigen::Isometry3d& T_base_cam) const;
 
  private:
-  // Starts a lane unless the observation is short or near a lane (loose gates).
+  // Starts a lane unless the observation is short, near a lane (loose gates) or along a
+  // mapped lane of another class.
   void Start(int class_id, const LaneMeasurement& measurement,
              const std::vector<Eigen::Vector3d>& usable_map, const FrameRecord& frame);
   // Grows the lane's ends with this frame's usable points and refines them with the

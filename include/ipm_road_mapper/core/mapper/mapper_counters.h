@@ -29,6 +29,9 @@ struct MapperCounters {
   // Unmatched but close to a lane of its class (within twice the gates): not a new line, so
   // not started (a second spline along one line would be a duplicate).
   std::uint64_t lane_observations_near_lane = 0;
+  // Unmatched and along a mapped lane of another class (a class flickering between solid and
+  // dashed): not started, the same line.
+  std::uint64_t lane_observations_other_class = 0;
   std::uint64_t results_applied = 0;   // back-end results merged into the map
   std::uint64_t results_rejected = 0;  // unusable (solver failure, trust bound)
   // Applied results whose refined extrinsic the guard refused (it explained the held-out

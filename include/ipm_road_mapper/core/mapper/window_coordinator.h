@@ -22,6 +22,11 @@
 
 namespace ipm_road_mapper {
 
+// The first frame whose lane observations still enter a window (the window's frames and one
+// more window of context before them; BuildSnapshot), for `frame_count` frames: lane data
+// of older frames is settled, no window moves anything with it any more.
+std::size_t LaneContextStart(const BackendOptions& options, std::size_t frame_count);
+
 class WindowCoordinator {
  public:
   // Starts the Backend when options.backend.enabled. The store and counters outlive it.
