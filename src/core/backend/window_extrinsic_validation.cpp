@@ -19,6 +19,10 @@ namespace {
 // there when the halves agreed.
 constexpr double kCandidateInformationRatio = 1.0;
 
+// A lever-arm shift smaller than this many of its sigmas is not told from the rough value's
+// error (a two-sided test at about 95 %; HoldInsignificantLeverArm).
+constexpr double kMinLeverArmShiftSigmas = 2.0;
+
 // Re-solves the map + extrinsic step on one half of the state's frames (0: those before the
 // middle frame, 1: from it on), from the solved state; nothing when the half has no data or
 // its solve is not usable.
@@ -74,6 +78,21 @@ std::array<bool, 6> ConfirmedDirections(const ExtrinsicObservability& observabil
   return confirmed;
 }
 
+int HoldInsignificantLeverArm(const ExtrinsicObservability& observability, double min_shift_sigmas,
+                              Vector6d* w) {
+  const Vector6d inverse = (observability.eigenvalues.array() + 1.0).inverse().matrix();
+  const Matrix6d covariance = observability.basis_whitened * inverse.asDiagonal() *
+                              observability.basis_whitened.transpose();
+  int held = 0;
+  for (int i = 3; i <= 4; ++i) {
+    if ((*w)(i) == 0.0 || std::abs((*w)(i)) >= min_shift_sigmas * std::sqrt(covariance(i, i)))
+      continue;
+    (*w)(i) = 0.0;
+    ++held;
+  }
+  return held;
+}
+
 int CrossValidateExtrinsic(const WindowSnapshot& snapshot, const BackendOptions& options,
                            double time_limit_s, WindowState* state) {
   if (!state->observability_valid || state->extrinsic_frozen || snapshot.frames.size() < 2) {
@@ -102,6 +121,7 @@ int CrossValidateExtrinsic(const WindowSnapshot& snapshot, const BackendOptions&
       ++sent_back;
     }
   }
+  HoldInsignificantLeverArm(state->observability, kMinLeverArmShiftSigmas, &w_kept);
   state->observability.observed = confirmed;  // what the drive's calibration stands on
   state->observability.CountObserved();
   if ((w_kept - w_full).norm() == 0.0) return sent_back;
