@@ -1,7 +1,7 @@
 // The cross-validation of the refined extrinsic (window_extrinsic_validation.h): a direction
 // keeps its refinement only when independent parts of the data (the halves in time; any
-// other split) each observe it and agree on it; a lever-arm shift inside its own sigmas is
-// held; and ExtrinsicObservability::CountObserved.
+// other split) each observe it and agree on it; a translation shift inside its own sigmas
+// is held; and ExtrinsicObservability::CountObserved.
 #include <gtest/gtest.h>
 
 #include "ipm_road_mapper/core/backend/extrinsic_observability.h"
@@ -41,23 +41,26 @@ Vector6d Axis(int i, double value) {
   return w;
 }
 
-TEST(HoldInsignificantLeverArm, HoldsALeverArmShiftInsideItsOwnSigmas) {
+TEST(HoldInsignificantTranslation, HoldsATranslationShiftInsideItsOwnSigmas) {
   // x known 8x better than the prior (sigma 1/3 of the prior's), y 0.5x (sigma 0.82).
   Matrix6d H = 100.0 * Matrix6d::Identity();
   H(3, 3) = 8.0;
   H(4, 4) = 0.5;
   const ExtrinsicObservability o = AnalyzeObservability(H, Vector6d::Ones(), 4.0);
-  Vector6d w = Axis(0, 0.3) + Axis(3, 0.9) + Axis(4, 0.9) + Axis(5, 0.05);
-  // x moved 2.7 sigmas: kept; y 1.1 sigmas: held; rotation and height are never touched.
-  EXPECT_EQ(HoldInsignificantLeverArm(o, 2.0, &w), 1);
+  Vector6d w = Axis(0, 0.01) + Axis(3, 0.9) + Axis(4, 0.9) + Axis(5, 0.5);
+  // x moved 2.7 sigmas: kept; y 1.1 sigmas: held; z 5 sigmas (0.1): kept; rotation never
+  // touched, however small its shift.
+  EXPECT_EQ(HoldInsignificantTranslation(o, 2.0, &w), 1);
   EXPECT_DOUBLE_EQ(w(3), 0.9);
   EXPECT_DOUBLE_EQ(w(4), 0.0);
-  EXPECT_DOUBLE_EQ(w(0), 0.3);
-  EXPECT_DOUBLE_EQ(w(5), 0.05);
-  // A smaller x shift (0.5, 1.5 sigmas) goes back too.
+  EXPECT_DOUBLE_EQ(w(0), 0.01);
+  EXPECT_DOUBLE_EQ(w(5), 0.5);
+  // Smaller x and z shifts (1.5 and 1 sigmas) go back too.
   w(3) = 0.5;
-  EXPECT_EQ(HoldInsignificantLeverArm(o, 2.0, &w), 1);
+  w(5) = 0.1;
+  EXPECT_EQ(HoldInsignificantTranslation(o, 2.0, &w), 2);
   EXPECT_DOUBLE_EQ(w(3), 0.0);
+  EXPECT_DOUBLE_EQ(w(5), 0.0);
 }
 
 TEST(ConfirmedDirections, AgreeingPartsConfirmOnlyObservedDirections) {

@@ -19,9 +19,9 @@ namespace {
 // there when the halves agreed.
 constexpr double kCandidateInformationRatio = 1.0;
 
-// A lever-arm shift smaller than this many of its sigmas is not told from the rough value's
-// error (a two-sided test at about 95 %; HoldInsignificantLeverArm).
-constexpr double kMinLeverArmShiftSigmas = 2.0;
+// A translation shift smaller than this many of its sigmas is not told from the rough value's
+// error (a two-sided test at about 95 %; HoldInsignificantTranslation).
+constexpr double kMinTranslationShiftSigmas = 2.0;
 
 // Re-solves the map + extrinsic step on one half of the state's frames (0: those before the
 // middle frame, 1: from it on), from the solved state; nothing when the half has no data or
@@ -78,13 +78,13 @@ std::array<bool, 6> ConfirmedDirections(const ExtrinsicObservability& observabil
   return confirmed;
 }
 
-int HoldInsignificantLeverArm(const ExtrinsicObservability& observability, double min_shift_sigmas,
-                              Vector6d* w) {
+int HoldInsignificantTranslation(const ExtrinsicObservability& observability,
+                                 double min_shift_sigmas, Vector6d* w) {
   const Vector6d inverse = (observability.eigenvalues.array() + 1.0).inverse().matrix();
   const Matrix6d covariance = observability.basis_whitened * inverse.asDiagonal() *
                               observability.basis_whitened.transpose();
   int held = 0;
-  for (int i = 3; i <= 4; ++i) {
+  for (int i = 3; i <= 5; ++i) {
     if ((*w)(i) == 0.0 || std::abs((*w)(i)) >= min_shift_sigmas * std::sqrt(covariance(i, i)))
       continue;
     (*w)(i) = 0.0;
@@ -121,7 +121,7 @@ int CrossValidateExtrinsic(const WindowSnapshot& snapshot, const BackendOptions&
       ++sent_back;
     }
   }
-  HoldInsignificantLeverArm(state->observability, kMinLeverArmShiftSigmas, &w_kept);
+  HoldInsignificantTranslation(state->observability, kMinTranslationShiftSigmas, &w_kept);
   state->observability.observed = confirmed;  // what the drive's calibration stands on
   state->observability.CountObserved();
   if ((w_kept - w_full).norm() == 0.0) return sent_back;

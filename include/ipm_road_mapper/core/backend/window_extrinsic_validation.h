@@ -40,14 +40,14 @@ std::array<bool, 6> ConfirmedDirections(const ExtrinsicObservability& observabil
                                         const std::vector<std::array<PartEstimate, 2>>& splits,
                                         double min_information_ratio);
 
-// The lever arm (x, y: whitened axes 3 and 4 of w) moves only where its shift stands out of
-// its own uncertainty: an axis whose |w_i| is below min_shift_sigmas of its marginal
+// The translation (x, y, z: whitened axes 3-5 of w) moves only where its shift stands out
+// of its own uncertainty: an axis whose |w_i| is below min_shift_sigmas of its marginal
 // posterior sigma sqrt(C_ii), C = V (Lambda + 1)^-1 V^T (data plus the mounting prior, in
-// prior-whitened units), goes back to the rough value. Rotation and height are seen by every
-// ground pixel; the lever arm only through the motion, and a shift it cannot tell from
-// noise is more likely a pull of the map than a calibration. Returns how many axes it held.
-int HoldInsignificantLeverArm(const ExtrinsicObservability& observability, double min_shift_sigmas,
-                              Vector6d* w);
+// prior-whitened units), goes back to the rough value. The lever arm is seen only through
+// the motion, the height with the pitch; a shift the data cannot tell from noise is more
+// likely a pull of the map than a calibration. Returns how many axes it held.
+int HoldInsignificantTranslation(const ExtrinsicObservability& observability,
+                                 double min_shift_sigmas, Vector6d* w);
 
 // The cross-validation (see the file comment) of the state after a solve: directions that
 // are not confirmed go back to the prior's center (the rough extrinsic), and the map and
