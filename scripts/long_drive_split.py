@@ -135,7 +135,8 @@ class DriveSplit:
         return part
 
     def map_part(self, d0, d1):
-        """The map of [d0, d1): markings, spline segments and poses inside."""
+        """The map of [d0, d1): markings, spline segments and poses inside. The lane pieces
+        are renumbered, so they carry no topology (it named the whole map's lane ids)."""
         part = copy.copy(self.map)
         part["markings"] = [m for m, d in zip(self.map["markings"], self.map_marking_d)
                             if d0 <= d < d1]
@@ -145,7 +146,8 @@ class DriveSplit:
             for begin, end in runs([d0 <= d < d1 for d in distances]):
                 first, last = begin + 1, end  # segments first .. last, with phantom ends
                 part["lanes"].append(dict(lane, control_points=c[first - 1:last + 3],
-                                          id=len(part["lanes"]) + 1))
+                                          id=len(part["lanes"]) + 1, predecessors=[],
+                                          successors=[]))
         part["trajectory"] = [p for p in self.map.get("trajectory", [])
                               if d0 <= self.index.distance_at_stamp(p["stamp"]) < d1]
         return part

@@ -84,6 +84,18 @@ class DriveSplitTest(unittest.TestCase):
                     self.assertLessEqual(p[0], d1 + 3.0)
         self.assertEqual(sorted(segments), list(range(1, len(original) - 2)))
 
+    def test_renumbered_lane_pieces_carry_no_stale_topology(self):
+        # A joined map names lanes by the whole map's ids; the crop renumbers its pieces, so a
+        # kept predecessor could name the piece itself (evaluate_map refuses such a map).
+        whole = vector_map()
+        whole["lanes"][0]["predecessors"] = [1]
+        whole["lanes"][0]["successors"] = [9]
+        split = long_drive_split.DriveSplit(ground_truth(), whole, margin_m=30.0)
+        for d0, d1 in self.parts:
+            for lane in split.map_part(d0, d1)["lanes"]:
+                self.assertEqual(lane["predecessors"], [])
+                self.assertEqual(lane["successors"], [])
+
     def test_markings_frames_and_poses_are_cropped(self):
         map_part = self.split.map_part(100.0, 200.0)
         self.assertEqual([m["id"] for m in map_part["markings"]], [101])
