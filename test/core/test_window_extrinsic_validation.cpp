@@ -46,21 +46,26 @@ TEST(HoldInsignificantTranslation, HoldsATranslationShiftInsideItsOwnSigmas) {
   Matrix6d H = 100.0 * Matrix6d::Identity();
   H(3, 3) = 8.0;
   H(4, 4) = 0.5;
-  const ExtrinsicObservability o = AnalyzeObservability(H, Vector6d::Ones(), 4.0);
+  ExtrinsicObservability o = AnalyzeObservability(H, Vector6d::Ones(), 4.0);
+  ASSERT_TRUE(o.axis_observed[3] && o.axis_observed[5]);
   Vector6d w = Axis(0, 0.01) + Axis(3, 0.9) + Axis(4, 0.9) + Axis(5, 0.5);
   // x moved 2.7 sigmas: kept; y 1.1 sigmas: held; z 5 sigmas (0.1): kept; rotation never
   // touched, however small its shift.
-  EXPECT_EQ(HoldInsignificantTranslation(o, 2.0, &w), 1);
+  EXPECT_EQ(HoldInsignificantTranslation(2.0, &o, &w), 1);
   EXPECT_DOUBLE_EQ(w(3), 0.9);
   EXPECT_DOUBLE_EQ(w(4), 0.0);
   EXPECT_DOUBLE_EQ(w(0), 0.01);
   EXPECT_DOUBLE_EQ(w(5), 0.5);
+  EXPECT_TRUE(o.axis_observed[3]);  // kept: still calibrated
   // Smaller x and z shifts (1.5 and 1 sigmas) go back too.
   w(3) = 0.5;
   w(5) = 0.1;
-  EXPECT_EQ(HoldInsignificantTranslation(o, 2.0, &w), 2);
+  EXPECT_EQ(HoldInsignificantTranslation(2.0, &o, &w), 2);
   EXPECT_DOUBLE_EQ(w(3), 0.0);
   EXPECT_DOUBLE_EQ(w(5), 0.0);
+  // Held at the rough value, they are no longer reported as calibrated.
+  EXPECT_FALSE(o.axis_observed[3]);
+  EXPECT_FALSE(o.axis_observed[5]);
 }
 
 TEST(ConfirmedDirections, AgreeingPartsConfirmOnlyObservedDirections) {

@@ -78,16 +78,17 @@ std::array<bool, 6> ConfirmedDirections(const ExtrinsicObservability& observabil
   return confirmed;
 }
 
-int HoldInsignificantTranslation(const ExtrinsicObservability& observability,
-                                 double min_shift_sigmas, Vector6d* w) {
-  const Vector6d inverse = (observability.eigenvalues.array() + 1.0).inverse().matrix();
-  const Matrix6d covariance = observability.basis_whitened * inverse.asDiagonal() *
-                              observability.basis_whitened.transpose();
+int HoldInsignificantTranslation(double min_shift_sigmas, ExtrinsicObservability* observability,
+                                 Vector6d* w) {
+  const Vector6d inverse = (observability->eigenvalues.array() + 1.0).inverse().matrix();
+  const Matrix6d covariance = observability->basis_whitened * inverse.asDiagonal() *
+                              observability->basis_whitened.transpose();
   int held = 0;
   for (int i = 3; i <= 5; ++i) {
     if ((*w)(i) == 0.0 || std::abs((*w)(i)) >= min_shift_sigmas * std::sqrt(covariance(i, i)))
       continue;
     (*w)(i) = 0.0;
+    observability->axis_observed[i] = false;  // held at the rough value: not calibrated
     ++held;
   }
   return held;
@@ -121,9 +122,9 @@ int CrossValidateExtrinsic(const WindowSnapshot& snapshot, const BackendOptions&
       ++sent_back;
     }
   }
-  HoldInsignificantTranslation(state->observability, kMinTranslationShiftSigmas, &w_kept);
   state->observability.observed = confirmed;  // what the drive's calibration stands on
   state->observability.CountObserved();
+  HoldInsignificantTranslation(kMinTranslationShiftSigmas, &state->observability, &w_kept);
   if ((w_kept - w_full).norm() == 0.0) return sent_back;
   // The kept extrinsic, held while the map and the poses follow it.
   state->extrinsic = PoseBlocks(snapshot.extrinsic_prior.FromDelta(w_kept.cwiseProduct(sigma)));

@@ -45,9 +45,10 @@ std::array<bool, 6> ConfirmedDirections(const ExtrinsicObservability& observabil
 // posterior sigma sqrt(C_ii), C = V (Lambda + 1)^-1 V^T (data plus the mounting prior, in
 // prior-whitened units), goes back to the rough value. The lever arm is seen only through
 // the motion, the height with the pitch; a shift the data cannot tell from noise is more
-// likely a pull of the map than a calibration. Returns how many axes it held.
-int HoldInsignificantTranslation(const ExtrinsicObservability& observability,
-                                 double min_shift_sigmas, Vector6d* w);
+// likely a pull of the map than a calibration. A held axis is no longer reported observed
+// (axis_observed). Returns how many axes it held.
+int HoldInsignificantTranslation(double min_shift_sigmas, ExtrinsicObservability* observability,
+                                 Vector6d* w);
 
 // The cross-validation (see the file comment) of the state after a solve: directions that
 // are not confirmed go back to the prior's center (the rough extrinsic), and the map and
