@@ -136,12 +136,17 @@ TEST(MapStore, TheCorrectionOfASolvedFrameComesOutOnTheFramesAfterIt) {
   for (int i = 0; i < 5; ++i) store.AddFrame(i, Pose(2.0 * i, 0.1 * i, 0.0, 0.0, 0.0, 0.01 * i));
   EXPECT_TRUE(store.T_map_odom().isApprox(Eigen::Isometry3d::Identity()));
   EXPECT_TRUE(store.CorrectedPose(4).isApprox(store.frames()[4].T_map_base_odom));
-  // A solve moved frames 1 and 2 (a shift and a turn), the newest it moved is 2.
+  // A solve moved frames 1 and 2 by one correction (a shift and a turn), the newest it moved
+  // is 2 (odometry_correction.h fits it over both).
   const Eigen::Isometry3d T_map_odom = Pose(0.3, -0.2, 0.01, 0.0, 0.0, 0.02);
-  const Eigen::Isometry3d T_1 = Pose(2.1, 0.0, 0.0, 0.0, 0.0, 0.0);
+  const Eigen::Isometry3d T_1 = T_map_odom * store.frames()[1].T_map_base_odom;
   store.SetFramePose(1, T_1);
   store.SetFramePose(2, T_map_odom * store.frames()[2].T_map_base_odom);
-  store.SetCorrectionFrom(2);
+  store.SetCorrectionFrom({});  // nothing moved: no change
+  EXPECT_TRUE(store.T_map_odom().isApprox(Eigen::Isometry3d::Identity()));
+  EXPECT_EQ(store.corrected_frame(), -1);
+  store.SetCorrectionFrom({1, 2});
+  EXPECT_EQ(store.corrected_frame(), 2);
   EXPECT_TRUE(store.T_map_odom().isApprox(T_map_odom, 1e-12));
   // Solved frames come out as solved; later ones carry the correction along the odometry.
   EXPECT_TRUE(store.CorrectedPose(1).isApprox(T_1));

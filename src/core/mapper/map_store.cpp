@@ -4,6 +4,7 @@
 #include <cmath>
 
 #include "ipm_road_mapper/core/geometry/catmull_rom_spline.h"
+#include "ipm_road_mapper/core/mapper/odometry_correction.h"
 
 namespace ipm_road_mapper {
 
@@ -28,10 +29,10 @@ void MapStore::SetFramePose(std::size_t index, const Eigen::Isometry3d& T_map_ba
   frame_index_.Set(index, T_map_base.translation());
 }
 
-void MapStore::SetCorrectionFrom(std::size_t index) {
-  const FrameRecord& frame = map_.frames[index];
-  T_map_odom_ = frame.T_map_base * frame.T_map_base_odom.inverse();
-  corrected_frame_ = static_cast<std::int64_t>(index);
+void MapStore::SetCorrectionFrom(const std::vector<std::size_t>& solved) {
+  if (solved.empty()) return;
+  T_map_odom_ = FitOdometryCorrection(map_.frames, solved);
+  corrected_frame_ = static_cast<std::int64_t>(*std::max_element(solved.begin(), solved.end()));
 }
 
 Eigen::Isometry3d MapStore::CorrectedPose(std::size_t index) const {

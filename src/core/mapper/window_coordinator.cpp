@@ -366,17 +366,17 @@ void WindowCoordinator::ApplyResult(const WindowResult& result, bool include_ret
   }
   // The poses the pose step moved; the others are the snapshot's and may since have been
   // corrected by a newer result.
-  std::int64_t newest_optimized = -1;
+  std::vector<std::size_t> optimized;
   for (const WindowFrame& f : result.frames) {
     if (f.in_window && f.optimized && f.index < store_->frames().size()) {
       store_->SetFramePose(f.index, f.T_map_base);
-      newest_optimized = std::max(newest_optimized, static_cast<std::int64_t>(f.index));
+      optimized.push_back(f.index);
     }
   }
-  // The newest corrected frame's correction, carried along the odometry to the frames after
-  // it in the outputs (MapStore::CorrectedPose; the estimator keeps the raw odometry as
-  // their start and prior: the correction is never a measurement).
-  if (newest_optimized >= 0) store_->SetCorrectionFrom(static_cast<std::size_t>(newest_optimized));
+  // The correction fitted over the moved frames, carried along the odometry to the frames
+  // after them in the outputs (MapStore::CorrectedPose; the estimator keeps the raw odometry
+  // as their start and prior: the correction is never a measurement).
+  store_->SetCorrectionFrom(optimized);
   if (result.covariance_frame >= 0 &&
       static_cast<std::size_t>(result.covariance_frame) < store_->frames().size()) {
     pose_covariance_frame_ = result.covariance_frame;

@@ -29,10 +29,10 @@ class MapStore {
   const FrameRecord& AddFrame(double stamp, const Eigen::Isometry3d& T_map_base_odom);
   // Sets frame `index`'s corrected pose (a back-end result).
   void SetFramePose(std::size_t index, const Eigen::Isometry3d& T_map_base);
-  // Takes the correction of frame `index`, a frame a solve just moved (its corrected pose
-  // times its odometry's inverse), as the current one: the frames after it, which no solve
-  // has reached yet, come out corrected by it (CorrectedPose).
-  void SetCorrectionFrom(std::size_t index);
+  // Takes the correction fitted over `solved`, the frames a solve just moved
+  // (odometry_correction.h), as the current one: the frames after the newest of them, which
+  // no solve has reached yet, come out corrected by it (CorrectedPose). Empty: no change.
+  void SetCorrectionFrom(const std::vector<std::size_t>& solved);
   // The current correction, T_map_odom: the corrected map frame from the odometry's frame
   // (identity until a solve moved a frame).
   const Eigen::Isometry3d& T_map_odom() const { return T_map_odom_; }

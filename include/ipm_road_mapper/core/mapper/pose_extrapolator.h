@@ -1,11 +1,13 @@
 // The corrected pose of the frames after the last solve (docs/backend.md, "Poses after a
-// solve"): the window's pose step without the map, over the unsolved tail. The two newest
-// solved frames are data; every later frame is free with
-//   - its pose prior (pose_prior_residual.h) on the odometry carried by the correction,
-//     T_map_odom * T_odom_base (backend.pose_prior_sigma_*: the odometry's per-pose noise),
+// solve"): the window's pose step without the map, over the last second of frames. Every
+// frame of it is free with
+//   - its pose prior (pose_prior_residual.h): a solved frame on its solved pose, a later one
+//     on the odometry carried by the correction, T_map_odom * T_odom_base
+//     (backend.pose_prior_sigma_*: the odometry's per-pose noise),
 //   - the motion prior (motion_prior_residual.h) over each three consecutive frames.
 // So the newest pose is the solved trajectory continued with the vehicle's smooth motion and
-// the odometry's increments, not the newest odometry message with its own random error.
+// the odometry's increments, not the newest odometry message with its own random error, and
+// its velocity comes from the second of frames, not from the two newest solved ones.
 #pragma once
 
 #include <Eigen/Geometry>
