@@ -27,9 +27,9 @@ FRAMES = 300  # 15 s at 20 Hz
 SCENARIO = os.path.join(irm.SOURCE_DIR, "config", "scenarios", "public_road.yaml")
 # The corrected poses' mean error at most this fraction of the input's. Measured
 # 0.63-0.65 (0.0855 -> 0.054-0.055 m over four runs; was 0.76 with the two newest solved
-# frames held as the tail's data and the correction of one frame); issue 13's target, 0.6, is not reached yet: the newest pose is
-# a causal estimate (no later frame smooths it) and the motion prior bends it on curves
-# (pose_extrapolator.h). A correction that made the poses worse (1.5x with the velocity taken
+# frames held as the tail's data and the correction of one frame); issue 13's target, 0.6,
+# is not reached yet: the newest pose is a causal estimate (no later frame smooths it) and
+# the motion prior bends it on curves (pose_extrapolator.h). A correction that made the poses worse (1.5x with the velocity taken
 # from the odometry) fails here.
 MAX_ERROR_RATIO = 0.7
 
