@@ -133,6 +133,7 @@ void MarkingTracker::Associate(const std::vector<MarkingObservation>& observatio
     for (int i = 0; i < 4; ++i) candidate.corners_map[i] = frame.T_map_base * obs.corners_base[i];
     candidate.center_cov_map = R * obs.center_cov_base * R.transpose();
     candidate.complete = obs.Complete();
+    candidate.side_measured = obs.side_measured;
     candidates.push_back(candidate);
   }
   // The live markings and the retired ones within the gate of some candidate (re-observed

@@ -3,6 +3,7 @@
 #include <algorithm>
 #include <unordered_map>
 
+#include "ipm_road_mapper/core/mapper/marking_extent.h"
 #include "ipm_road_mapper/core/mapper/window_coordinator.h"
 
 namespace ipm_road_mapper {
@@ -55,7 +56,12 @@ void WindowCoordinator::ApplyResult(const WindowResult& result, bool include_ret
     for (const WindowMarking& wm : result.markings) {
       auto it = by_id.find(wm.id);
       if (it == by_id.end() || (it->second->retired && !include_retired)) continue;
-      it->second->corners_map = wm.corners_map;
+      MarkingElement& marking = *it->second;
+      // A partial extent keeps its shape and its unmeasured sides (RectifyPartialExtent).
+      marking.corners_map =
+          marking.Complete()
+              ? wm.corners_map
+              : RectifyPartialExtent(marking.corners_map, wm.corners_map, marking.side_measured);
       it->second->optimized = true;
       store_->Touch(it->second);
     }
