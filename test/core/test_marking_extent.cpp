@@ -1,6 +1,9 @@
 // Tests of the extent of a marking seen in partial views (marking_extent.h).
 #include <gtest/gtest.h>
 
+#include <Eigen/Geometry>
+#include <cmath>
+
 #include "ipm_road_mapper/core/mapper/marking_extent.h"
 
 namespace ipm_road_mapper {
@@ -69,6 +72,41 @@ TEST(MarkingExtent, SideAlignedShiftPairsSidesOfASmallerView) {
                                                Eigen::Vector3d(2, 0, 0), Eigen::Vector3d(6, 0, 0)};
   EXPECT_EQ(SideAlignedShift(element, view), 2);
   EXPECT_EQ(SideAlignedShift(element, element), 0);
+}
+
+TEST(MarkingExtent, RectifiedPartialExtentKeepsItsShapeAndItsUnmeasuredSides) {
+  // A solve slid the cut corner 2 of a 4 m x 10 m crossing (between the cut side 1, x = 24,
+  // and the measured side 2, y = 5) 6 m inwards along side 2's line, moved the measured sides
+  // by 0.1 m and raised corner 2 by 0.3 m.
+  const MarkingElement before = PartialCrossing();
+  std::array<Eigen::Vector3d, 4> refined = Rect(20.0, 24.0, -4.9, 5.1);
+  refined[2].x() -= 6.0;
+  refined[2].z() = 0.3;
+  const std::array<Eigen::Vector3d, 4> r =
+      RectifyPartialExtent(before.corners_map, refined, before.side_measured);
+  // Measured sides where the solve put them, the cut ones where the extent had them.
+  const std::array<Eigen::Vector3d, 4> expected = Rect(20.0, 24.0, -4.9, 5.1);
+  for (int c = 0; c < 4; ++c) {
+    EXPECT_NEAR(r[c].x(), expected[c].x(), 1e-9) << "corner " << c;
+    EXPECT_NEAR(r[c].y(), expected[c].y(), 1e-9) << "corner " << c;
+  }
+  EXPECT_NEAR(r[2].z(), 0.3, 1e-12);  // heights are the solve's
+}
+
+TEST(MarkingExtent, RectifiedPartialExtentTakesTheMeasuredSidesOrientation) {
+  // The solve turned the measured sides by 2 deg about the element's center: so does the
+  // rectangle, with the cut sides still at their offsets along the turned normals.
+  const MarkingElement before = PartialCrossing();
+  const double a = 2.0 * M_PI / 180.0;
+  const Eigen::Matrix3d R = Eigen::AngleAxisd(a, Eigen::Vector3d::UnitZ()).toRotationMatrix();
+  std::array<Eigen::Vector3d, 4> refined = before.corners_map;
+  const Eigen::Vector3d center(22.0, 0.0, 0.0);
+  for (Eigen::Vector3d& c : refined) c = center + R * (c - center);
+  const std::array<Eigen::Vector3d, 4> r =
+      RectifyPartialExtent(before.corners_map, refined, before.side_measured);
+  const Eigen::Vector2d side0 = (r[1] - r[0]).head<2>();
+  EXPECT_NEAR(std::atan2(side0.y(), side0.x()), a, 1e-9);
+  EXPECT_NEAR(side0.dot((r[2] - r[1]).head<2>()), 0.0, 1e-9);
 }
 
 }  // namespace

@@ -6,6 +6,7 @@
 #include <opencv2/imgproc.hpp>
 #include <tuple>
 
+#include "ipm_road_mapper/core/frontend/partial_view_association.h"
 #include "ipm_road_mapper/core/geometry/catmull_rom_spline.h"
 
 namespace ipm_road_mapper {
@@ -154,6 +155,14 @@ std::vector<int> AssociateMarkings(const std::vector<const MarkingElement*>& ele
             OverlapOfSmaller(elements[e]->corners_map, candidates[c].corners_map);
         if (overlap >= options.marking_merge_overlap && overlap > 0.0) {
           cost = std::min(cost, gate * (1.0 - overlap));
+        }
+        // Or, for an element never seen whole (larger than the view: its center is where
+        // the views ended), its measured sides lie on the element's (PartialViewCost). An
+        // element seen whole keeps the center gate: its center is measured, and a crossing's
+        // stripes 1 m apart are within the sides' gate of each other.
+        if (!elements[e]->Complete()) {
+          const double sides = PartialViewCost(*elements[e], candidates[c], options);
+          if (sides >= 0.0) cost = std::min(cost, sides);
         }
       }
       if (cost <= gate) pairs.emplace_back(cost, c, e);

@@ -65,4 +65,37 @@ void UpdateExtent(const std::array<Eigen::Vector3d, 4>& observation_corners_map,
   }
 }
 
+std::array<Eigen::Vector3d, 4> RectifyPartialExtent(
+    const std::array<Eigen::Vector3d, 4>& before_map,
+    const std::array<Eigen::Vector3d, 4>& refined_map, const std::array<bool, 4>& side_measured) {
+  const bool any_measured =
+      side_measured[0] || side_measured[1] || side_measured[2] || side_measured[3];
+  // Side s of a counter-clockwise rectangle runs along side 0's direction turned by s x 90 deg:
+  // each side turned back by s x 90 deg votes for side 0's direction.
+  Eigen::Vector2d u = Eigen::Vector2d::Zero();
+  for (int s = 0; s < 4; ++s) {
+    if (any_measured && !side_measured[s]) continue;
+    Eigen::Vector2d d = (refined_map[(s + 1) % 4] - refined_map[s]).head<2>();
+    for (int k = 0; k < s; ++k) d = Eigen::Vector2d(d.y(), -d.x());  // turn by -90 deg
+    u += d;
+  }
+  if (!(u.norm() > 1e-9)) return refined_map;
+  u.normalize();
+  const Eigen::Vector2d v(-u.y(), u.x());
+  // Outward normals of the sides (as in UpdateExtent: (along.y, -along.x)).
+  const std::array<Eigen::Vector2d, 4> outward{{-v, u, v, -u}};
+  std::array<double, 4> offset;
+  for (int s = 0; s < 4; ++s) {
+    const std::array<Eigen::Vector3d, 4>& source = side_measured[s] ? refined_map : before_map;
+    offset[s] = 0.5 * outward[s].dot(source[s].head<2>() + source[(s + 1) % 4].head<2>());
+  }
+  std::array<Eigen::Vector3d, 4> corners;
+  for (int c = 0; c < 4; ++c) {
+    const int previous = (c + 3) % 4;  // corner c lies on sides c - 1 and c
+    const Eigen::Vector2d xy = offset[c] * outward[c] + offset[previous] * outward[previous];
+    corners[c] = Eigen::Vector3d(xy.x(), xy.y(), refined_map[c].z());
+  }
+  return corners;
+}
+
 }  // namespace ipm_road_mapper

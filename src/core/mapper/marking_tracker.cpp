@@ -8,6 +8,7 @@
 #include "ipm_road_mapper/core/frontend/association.h"
 #include "ipm_road_mapper/core/frontend/instance_extraction.h"
 #include "ipm_road_mapper/core/mapper/marking_extent.h"
+#include "ipm_road_mapper/core/mapper/marking_pixel_agreement.h"
 #include "ipm_road_mapper/core/mapper/shared_frames.h"
 
 namespace ipm_road_mapper {
@@ -96,7 +97,7 @@ void MarkingTracker::Update(const Ipm& ipm, const FrameRecord& frame,
 
   Associate(*observations, frame);
   CheckConsistency(ipm, frame);
-  MergeDuplicates();
+  MergeDuplicates(ipm);
 }
 
 void MarkingTracker::OrientAlongRoad(const Ipm& ipm, const FrameRecord& frame,
@@ -132,6 +133,7 @@ void MarkingTracker::Associate(const std::vector<MarkingObservation>& observatio
     for (int i = 0; i < 4; ++i) candidate.corners_map[i] = frame.T_map_base * obs.corners_base[i];
     candidate.center_cov_map = R * obs.center_cov_base * R.transpose();
     candidate.complete = obs.Complete();
+    candidate.side_measured = obs.side_measured;
     candidates.push_back(candidate);
   }
   // The live markings and the retired ones within the gate of some candidate (re-observed
@@ -241,7 +243,7 @@ void MarkingTracker::CheckConsistency(const Ipm& ipm, const FrameRecord& frame) 
   }
 }
 
-void MarkingTracker::MergeDuplicates() {
+void MarkingTracker::MergeDuplicates(const Ipm& ipm) {
   // Two elements of one class at one place are one marking seen twice: typically a far
   // observation that missed the element (its IPM was meters off) started a second one, or a
   // close-range view (partly outside the image's useful part) did.
@@ -276,6 +278,31 @@ void MarkingTracker::MergeDuplicates() {
     }
     return true;
   };
+  // Whether b is a's nearest element of its class never seen in one frame with it.
+  auto nearest_unseen = [&](std::size_t a, std::size_t b) {
+    const double d2 = (markings[a].Center() - markings[b].Center()).head<2>().squaredNorm();
+    for (std::size_t c = 0; c < markings.size(); ++c) {
+      if (c == a || c == b || markings[c].retired || markings[c].class_id != markings[a].class_id)
+        continue;
+      if ((markings[a].Center() - markings[c].Center()).head<2>().squaredNorm() < d2 &&
+          !SeenInOneFrame(markings[a], markings[c])) {
+        return false;
+      }
+    }
+    return true;
+  };
+  // Beyond a crest (relief that flat IPM and its Omega_p do not model) the far views put a
+  // marking meters short in the map, outside the uncertainty gate: their pixels still agree
+  // with the element its nearer views made. The element with the better best view is the
+  // model, the other's views are compared with it.
+  auto pixels_agree = [&](std::size_t a, std::size_t b) {
+    const MarkingElement& x = markings[a];
+    const MarkingElement& y = markings[b];
+    if (SeenInOneFrame(x, y) || !nearest_unseen(a, b) || !nearest_unseen(b, a)) return false;
+    const bool x_model = x.center_cov_map.trace() <= y.center_cov_map.trace();
+    return PixelsAgree(ipm, options_.ipm.error_model, o.marking_gate_sigmas, store_->frames(),
+                       x_model ? x : y, x_model ? y : x);
+  };
   auto same_marking = [&](std::size_t a, std::size_t b) {
     const MarkingElement& x = markings[a];
     const MarkingElement& y = markings[b];
@@ -285,6 +312,7 @@ void MarkingTracker::MergeDuplicates() {
     // gate, never seen in one frame (two markings side by side are seen together; one
     // marking's two elements never are), and each the other's nearest such candidate.
     if (gate_candidates(a, b) && nearest_candidate(a, b) && nearest_candidate(b, a)) return true;
+    if (pixels_agree(a, b)) return true;
     if (o.marking_merge_overlap <= 0.0) return false;
     if (d.norm() > Radius(x) + Radius(y)) return false;  // rectangles that cannot touch
     return OverlapOfSmaller(x.corners_map, y.corners_map) >= o.marking_merge_overlap;

@@ -70,6 +70,7 @@ struct MarkingCandidate {
   std::array<Eigen::Vector3d, 4> corners_map;
   Eigen::Matrix2d center_cov_map = Eigen::Matrix2d::Zero();  // Omega_p (x-y) in the map frame
   bool complete = true;  // every side measured (not a partial view)
+  std::array<bool, 4> side_measured{{true, true, true, true}};  // which sides are real (cut: false)
 };
 
 // Area of the intersection of two ground rectangles (x-y), over the smaller one's area.

@@ -28,4 +28,16 @@ void UpdateExtent(const std::array<Eigen::Vector3d, 4>& observation_corners_map,
                   const std::array<bool, 4>& observation_sides, bool owned,
                   MarkingElement* element);
 
+// The rectangle of a partially seen element after the back end refined its corners. A cut
+// corner has no corner residual, only the edge residuals of its measured side, which leave it
+// free along that side's line: a solve slid such corners meters inwards and left a
+// quadrilateral that is no rectangle (urban's stop line 2.2 m off at its center). The result
+// is the rectangle with the refined corners' orientation (their sides, measured ones only
+// when there are any, length-weighted), each measured side where the refined corners put
+// it, and each unmeasured side where the extent had it before the solve (`before_map`: the
+// union of the views). The refined corners' heights are kept.
+std::array<Eigen::Vector3d, 4> RectifyPartialExtent(
+    const std::array<Eigen::Vector3d, 4>& before_map,
+    const std::array<Eigen::Vector3d, 4>& refined_map, const std::array<bool, 4>& side_measured);
+
 }  // namespace ipm_road_mapper

@@ -42,9 +42,10 @@ class MarkingTracker {
   // whether it did; confirms the consistent ones.
   void CheckConsistency(const Ipm& ipm, const FrameRecord& frame);
   // Merges elements of one class closer than association.marking_merge_distance_m, whose
-  // rectangles overlap by association.marking_merge_overlap, or within the gate of their
-  // combined uncertainty when no frame saw both and each is the other's nearest such element.
-  void MergeDuplicates();
+  // rectangles overlap by association.marking_merge_overlap, or, when no frame saw both and
+  // each is the other's nearest such element, within the gate of their combined uncertainty
+  // or with pixels that agree (PixelsAgree: one's views saw the other).
+  void MergeDuplicates(const Ipm& ipm);
 
   const MapperOptions& options_;
   MapStore* store_;

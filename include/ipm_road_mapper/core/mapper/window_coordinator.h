@@ -3,8 +3,9 @@
 // it, whose information moves into the extrinsic prior with their corners marginalized, and
 // lane observations older than the lanes' context), hands it to the Backend (an owned
 // optimizer thread, or inline when backend.synchronous), and merges the results into the
-// map at the start of the next frame. It holds the refined extrinsic the front end's IPM
-// uses (fed forward) and, at the end of input, runs the final global solve.
+// map at the start of the next frame (window_coordinator_snapshot, _retire, _apply.cpp). It holds
+// the refined extrinsic the front end's IPM uses (fed forward) and, at the end of input, runs the
+// final global solve.
 #pragma once
 
 #include <Eigen/Geometry>
@@ -19,13 +20,9 @@
 #include "ipm_road_mapper/core/mapper/map_store.h"
 #include "ipm_road_mapper/core/mapper/mapper_counters.h"
 #include "ipm_road_mapper/core/mapper/mapper_options.h"
+#include "ipm_road_mapper/core/mapper/window_lane_slice.h"  // LaneContextStart
 
 namespace ipm_road_mapper {
-
-// The first frame whose lane observations still enter a window (the window's frames and one
-// more window of context before them; BuildSnapshot), for `frame_count` frames: lane data
-// of older frames is settled, no window moves anything with it any more.
-std::size_t LaneContextStart(const BackendOptions& options, std::size_t frame_count);
 
 class WindowCoordinator {
  public:
