@@ -24,7 +24,7 @@ MapPublisher::MapPublisher(ros::NodeHandle& private_nh, int path_max_poses,
   path_pub_ = private_nh.advertise<nav_msgs::Path>("corrected_path", 1, true);
 }
 
-PublishCounts MapPublisher::Publish(const VectorMap& map, const std::string& map_frame,
+PublishCounts MapPublisher::Publish(const SharedVectorMap& map, const std::string& map_frame,
                                     const std::string& base_frame,
                                     const std::string& refined_camera_frame, const ros::Time& stamp,
                                     bool map_changed, const MapChanges* changes) {
@@ -34,10 +34,16 @@ PublishCounts MapPublisher::Publish(const VectorMap& map, const std::string& map
   const bool full = new_marker_subscriber_.exchange(false) || last_full_markers_.isZero() ||
                     now - last_full_markers_ >= marker_full_period_;
   if (full) last_full_markers_ = now;
+  // The whole map, copied out of the shared storage only for what needs every element.
+  std::optional<VectorMap> whole;
+  auto whole_map = [&]() -> const VectorMap& {
+    if (!whole) whole = map.ToVectorMap();
+    return *whole;
+  };
   const visualization_msgs::MarkerArray markers =
-      full      ? markers_.Build(map, map_frame, stamp, MarkerBuilder::Mode::kFull)
+      full      ? markers_.Build(whole_map(), map_frame, stamp, MarkerBuilder::Mode::kFull)
       : changes ? markers_.Build(*changes, map_frame, stamp)
-                : markers_.Build(map, map_frame, stamp, MarkerBuilder::Mode::kChanges);
+                : markers_.Build(whole_map(), map_frame, stamp, MarkerBuilder::Mode::kChanges);
   if (!markers.markers.empty()) {
     markers_pub_.publish(markers);
     counts.markers = markers.markers.size();
@@ -46,26 +52,28 @@ PublishCounts MapPublisher::Publish(const VectorMap& map, const std::string& map
   if (map_changed) {
     full_map_stale_ = true;
     const ipm_road_mapper::VectorMapDelta delta =
-        changes ? deltas_.Build(*changes, map_frame, stamp) : deltas_.Build(map, map_frame, stamp);
+        changes ? deltas_.Build(*changes, map_frame, stamp)
+                : deltas_.Build(whole_map(), map_frame, stamp);
     delta_pub_.publish(delta);
     counts.delta_elements = delta.markings.size() + delta.lanes.size() +
                             delta.removed_marking_ids.size() + delta.removed_lane_ids.size();
     counts.serialized_bytes += ros::serialization::serializationLength(delta);
-    const nav_msgs::Path path = ToPathMsg(map.trajectory, map_frame, path_max_poses_, stamp);
+    const nav_msgs::Path path = ToPathMsg(map.header.trajectory, map_frame, path_max_poses_, stamp);
     path_pub_.publish(path);
     counts.path_poses = path.poses.size();
     counts.serialized_bytes += ros::serialization::serializationLength(path);
-    const bool moved = !last_T_base_cam_ || !last_T_base_cam_->isApprox(map.T_base_cam, 1e-12);
+    const Eigen::Isometry3d& T_base_cam = map.header.T_base_cam;
+    const bool moved = !last_T_base_cam_ || !last_T_base_cam_->isApprox(T_base_cam, 1e-12);
     if (moved) {
       static_tf_.sendTransform(
-          IsometryToTransformStamped(map.T_base_cam, stamp, base_frame, refined_camera_frame));
-      last_T_base_cam_ = map.T_base_cam;
+          IsometryToTransformStamped(T_base_cam, stamp, base_frame, refined_camera_frame));
+      last_T_base_cam_ = T_base_cam;
     }
   }
   if (FullMapDueLocked(now)) {
     last_full_map_ = now;
     full_map_stale_ = false;
-    const ipm_road_mapper::VectorMapMsg full_map = ToVectorMapMsg(map, map_frame, stamp);
+    const ipm_road_mapper::VectorMapMsg full_map = ToVectorMapMsg(whole_map(), map_frame, stamp);
     vector_map_pub_.publish(full_map);
     counts.full_elements = full_map.markings.size() + full_map.lanes.size();
     counts.serialized_bytes += ros::serialization::serializationLength(full_map);

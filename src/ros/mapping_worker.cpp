@@ -25,8 +25,8 @@ constexpr std::size_t kMutableFramesPerWindowFrame = 10;
 
 std::shared_ptr<const VectorMap> MapSnapshot::FullMap() const {
   if (!map) return nullptr;
-  auto full = std::make_shared<VectorMap>(*map);
-  full->trajectory = FullTrajectory(trajectory_prefix, map->trajectory);
+  auto full = std::make_shared<VectorMap>(map->ToVectorMap());
+  full->trajectory = FullTrajectory(trajectory_prefix, map->header.trajectory);
   LinkLaneTopology(&full->lanes);  // a live snapshot's map has none (ExportOptions)
   return full;
 }
@@ -153,6 +153,7 @@ bool MappingWorker::RunCommands() {
   if (reset) {
     session_.Reset();
     frozen_trajectory_.Clear();
+    snapshot_cache_.Clear();
     ++map_version_;
     ++generation_;
     Export();  // the services and timers see the empty map at once
@@ -180,7 +181,7 @@ void MappingWorker::RunFinish(Clock::time_point deadline) {
     ++map_version_;
     Export();
     // Exported whole, not from the frozen chunks: the final solve may move older poses.
-    map = ExportMap(true);
+    map = ExportFinishedMap();
   }
   {
     std::lock_guard<std::mutex> lock(command_mutex_);
@@ -281,12 +282,12 @@ void MappingWorker::AfterUpdate(const SessionUpdate& update) {
   if (hooks_.overlay_wanted && hooks_.overlay_wanted() && now - last_overlay_ >= overlay_period_) {
     last_overlay_ = now;
     Export();
-    outputs.overlay_map = exported_map_;
+    outputs.overlay_map = std::make_shared<const VectorMap>(exported_map_->ToVectorMap());
   }
   if (hooks_.on_update) hooks_.on_update(update, outputs);
 }
 
-std::shared_ptr<VectorMap> MappingWorker::ExportMap(bool whole_trajectory) {
+std::shared_ptr<const SharedVectorMap> MappingWorker::ExportSnapshotMap() {
   const Mapper& mapper = *session_.mapper();
   const std::vector<FrameRecord>& frames = mapper.map().frames;
   const std::size_t mutable_frames =
@@ -296,19 +297,24 @@ std::shared_ptr<VectorMap> MappingWorker::ExportMap(bool whole_trajectory) {
   if (frames.size() > mutable_frames) {
     frozen_trajectory_.Extend(frames, frames.size() - mutable_frames);
   }
-  ExportOptions options;  // max_trajectory_poses 0: every pose
-  // The finished map is saved as it is; a snapshot's map is published, and FullMap links
-  // the topology of a copy for a save.
-  options.lane_topology = whole_trajectory;
-  if (!whole_trajectory) {
-    exported_prefix_ = frozen_trajectory_.chunks();
-    options.max_trajectory_poses = frames.size() - frozen_trajectory_.size();
-  }
-  auto map = std::make_shared<VectorMap>(mapper.ExportMap(options));
+  exported_prefix_ = frozen_trajectory_.chunks();
+  // No lane topology: no message carries it; FullMap links it on its copy for a save.
+  auto map = std::make_shared<SharedVectorMap>(
+      mapper.ExportSnapshot(frames.size() - frozen_trajectory_.size(), &snapshot_cache_));
+  Label(&map->header);
+  return map;
+}
+
+std::shared_ptr<const VectorMap> MappingWorker::ExportFinishedMap() const {
+  auto map = std::make_shared<VectorMap>(session_.mapper()->ExportMap());  // saved as it is
+  Label(map.get());
+  return map;
+}
+
+void MappingWorker::Label(VectorMap* map) const {
   map->frame_id = config_.ros.map_frame;
   map->metadata["source"] = "ipm_road_mapper/MapperNodelet " + node_name_;
   map->metadata["extrinsic_source"] = extrinsic_status_;
-  return map;
 }
 
 MapperStatusSnapshot MappingWorker::Status() const {
@@ -337,7 +343,7 @@ void MappingWorker::Published(std::uint64_t resets, std::uint64_t revision) {
 
 void MappingWorker::Export() {
   if (session_.started() && (map_version_ != exported_version_ || !exported_map_)) {
-    exported_map_ = ExportMap(false);
+    exported_map_ = ExportSnapshotMap();
     std::uint64_t since = 0;  // a publisher of an older map (before a reset) gets everything
     {
       std::lock_guard<std::mutex> lock(published_mutex_);

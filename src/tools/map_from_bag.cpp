@@ -35,20 +35,16 @@
 #include <rosbag/view.h>
 
 #include <chrono>
-#include <cmath>
 #include <cstdio>
 #include <cstdlib>
 #include <filesystem>
 #include <fstream>
 #include <iostream>
 #include <optional>
-#include <sstream>
 #include <stdexcept>
 #include <string>
 #include <utility>
 
-#include "ipm_road_mapper/core/backend/extrinsic_observability.h"
-#include "ipm_road_mapper/core/geometry/rigid_transform.h"
 #include "ipm_road_mapper/core/io/geojson_export.h"
 #include "ipm_road_mapper/core/map/vector_map.h"
 #include "ipm_road_mapper/core/mapper/mapper.h"
@@ -63,6 +59,7 @@
 #include "ipm_road_mapper/ros/bag_input.h"
 #include "ipm_road_mapper/ros/bag_mapping.h"
 #include "ipm_road_mapper/ros/bag_read_loss.h"
+#include "ipm_road_mapper/ros/bag_run_summary.h"
 #include "ipm_road_mapper/ros/publish_cost_probe.h"
 #include "ipm_road_mapper/ros/unindexed_bag.h"
 
@@ -155,145 +152,6 @@ Eigen::Isometry3d FindExtrinsic(rosbag::Bag* bag_ptr, const InputOptions& input,
   return choice.T_base_cam;
 }
 
-// What the run did, for summary.txt.
-struct RunStats {
-  std::size_t frames_read = 0;
-  double bag_span_s = 0.0;
-  double wall_s = 0.0;
-  std::optional<double> startup_s;  // process start to the first frame mapped
-  std::string extrinsic_source;
-  std::string camera_frame;           // the masks' frame (empty when the config gave the extrinsic)
-  BagReadLoss lost;                   // what could not be read (corrupt chunks)
-  double bag_begin_s = 0.0;           // the bag's first record time; lost spans are relative to it
-  std::string index_problem;          // why the bag had to be read past its index ("" = not)
-  std::optional<BagSalvage> salvage;  // what reading it in record order gave
-};
-
-// The summary line about the bag's index: "ok", or how the bag was read past a missing one.
-std::string IndexLine(const RunStats& stats) {
-  if (!stats.salvage) return "index: ok";
-  const BagSalvage& s = *stats.salvage;
-  std::ostringstream line;
-  line.setf(std::ios::fixed);
-  line.precision(2);
-  line << "index: missing (" << stats.index_problem << "): read in record order, " << s.messages
-       << " messages in " << s.chunks << " chunks (" << s.bad_chunks
-       << " chunks did not decompress), record times " << s.first_stamp - stats.bag_begin_s
-       << " to " << s.last_stamp - stats.bag_begin_s << " s; " << s.end
-       << "; whatever was recorded after that is lost";
-  return line.str();
-}
-
-// One line about the optimizer: windows, solve time, how far the extrinsic moved.
-std::string BackendLine(const Mapper& mapper) {
-  if (!mapper.options().backend.enabled) return "back end: disabled";
-  const BackendStats stats = mapper.backend_stats();
-  double total_s = 0.0;
-  for (double t : stats.solve_times_s) total_s += t;
-  const Eigen::Isometry3d change = mapper.T_base_cam_initial().inverse() * mapper.T_base_cam();
-  std::ostringstream s;
-  s.setf(std::ios::fixed);
-  s.precision(3);
-  s << "back end: " << stats.submitted << " windows submitted, " << stats.solved << " solved, "
-    << stats.dropped_queue_full << " dropped (queue full), " << stats.unusable << " unusable; "
-    << "solve time " << total_s << " s total; results applied " << mapper.counters().results_applied
-    << ", rejected " << mapper.counters().results_rejected << "; extrinsic moved "
-    << RotationAngleBetween(mapper.T_base_cam_initial(), mapper.T_base_cam()) * 180.0 / M_PI
-    << " deg, " << change.translation().norm() << " m";
-  return s.str();
-}
-
-// One line about the refined extrinsic as a calibration: its 1-sigma per axis, the axes the
-// data observed and how many refined extrinsics the guard refused.
-std::string CalibrationLine(const Mapper& mapper) {
-  const Eigen::Matrix<double, 6, 1> sigma =
-      mapper.T_base_cam_covariance().diagonal().cwiseMax(0.0).cwiseSqrt();
-  std::ostringstream s;
-  s.setf(std::ios::fixed);
-  s.precision(3);
-  s << "calibration: sigma roll pitch yaw " << sigma(0) * 180.0 / M_PI << " "
-    << sigma(1) * 180.0 / M_PI << " " << sigma(2) * 180.0 / M_PI << " deg, x y z " << sigma(3)
-    << " " << sigma(4) << " " << sigma(5)
-    << " m; observed: " << ObservedAxesText(mapper.extrinsic_observed())
-    << "; extrinsic updates rejected " << mapper.counters().extrinsic_rejected
-    << " (held-out frames explained worse)";
-  return s.str();
-}
-
-// One line about the front end's time per frame (the caller's thread).
-std::string FrontEndLine(const Mapper& mapper) {
-  const FrontEndTiming& t = mapper.frontend_timing();
-  std::ostringstream s;
-  s.setf(std::ios::fixed);
-  s.precision(2);
-  s << "front end: " << Quantile(t.total_ms, 0.5) << " ms/frame median, "
-    << Quantile(t.total_ms, 0.95) << " ms p95, " << Quantile(t.total_ms, 1.0)
-    << " ms max (extraction " << Quantile(t.extraction_ms, 0.5) << " ms median)";
-  return s.str();
-}
-
-// Seconds with 3 decimals, or "none" when no frame was mapped.
-std::string StartupText(const std::optional<double>& startup_s) {
-  if (!startup_s) return "none";
-  char text[32];
-  std::snprintf(text, sizeof(text), "%.3f", *startup_s);
-  return text;
-}
-
-std::string Summary(const Arguments& args, const Mapper& mapper, const FrameAssembler& assembler,
-                    const VectorMap& map, const RunStats& stats) {
-  const MapperCounters& c = mapper.counters();
-  const FrameAssemblerCounters& a = assembler.counters();
-  const ExtractionCounters& e = c.extraction;
-  std::ostringstream s;
-  s.setf(std::ios::fixed);
-  s.precision(2);
-  s << "bag: " << args.bag << "\nconfig: " << args.config << " (method " << mapper.options().method
-    << ")\nclasses: " << args.classes << "\nextrinsic: " << stats.extrinsic_source << "\n"
-    << "frames read: " << stats.frames_read << "\nframes used: " << c.frames_used
-    << "\nframes skipped: " << c.SkippedTotal() << "\n";
-  for (const auto& [reason, count] : c.frames_skipped) s << "  " << reason << ": " << count << "\n";
-  s << "odometry: " << a.odometry_received << " received, " << a.odometry_used << " used, "
-    << a.bad_odometry << " bad, " << a.odometry_out_of_order
-    << " out of order; time jumps: " << a.time_jumps << "\n"
-    << "extraction: " << e.instances_seen << " instances; dropped: unknown class "
-    << e.dropped_unknown_class << ", tiny " << e.dropped_tiny << ", border " << e.dropped_border
-    << ", range " << e.dropped_range << ", degenerate " << e.dropped_degenerate
-    << ", instance limit " << e.dropped_instance_limit << "; partial markings kept "
-    << e.partial_markings << "\n"
-    << "implausible: " << e.dropped_oversized << " oversized markings, " << e.dropped_wide_lane
-    << " wide lanes (" << e.lane_runs_too_wide << " lane runs too wide), " << e.dropped_doubled_lane
-    << " lanes doubling back (" << e.lane_rows_doubled
-    << " lane rows of several runs), frames without observations: " << e.frames_too_many_instances
-    << " too many instances, " << e.frames_too_much_coverage << " too much coverage ("
-    << e.dropped_absurd_frame << " instances); odometry reordered " << a.odometry_reordered << "\n"
-    << "map: " << map.markings.size() << " markings, " << map.lanes.size() << " lanes (created "
-    << c.markings_created << " markings, " << c.lanes_created << " lanes; spurious dropped "
-    << c.spurious_dropped << ", lanes merged " << c.lanes_merged << ", joined " << c.lanes_joined
-    << ", lane observations unused " << c.lane_observations_unused << ", near a lane "
-    << c.lane_observations_near_lane << ", along a lane of another class "
-    << c.lane_observations_other_class << ")\n"
-    << BackendLine(mapper) << "\n"
-    << CalibrationLine(mapper) << "\n"
-    << FrontEndLine(mapper) << "\n"
-    << "startup_s: " << StartupText(stats.startup_s)
-    << " (process start to the first frame mapped)\n"
-    << IndexLine(stats) << "\n"
-    << "lost: " << stats.lost.messages << " messages (" << stats.lost.masks << " masks) in "
-    << stats.lost.spans.size()
-    << " unreadable spans: " << FormatLostSpans(stats.lost, stats.bag_begin_s)
-    << (stats.lost.empty() ? "" : " (first error: " + stats.lost.first_error + ")") << "\n"
-    << "wall time: " << stats.wall_s << " s; "
-    << (stats.wall_s > 0 ? stats.frames_read / stats.wall_s : 0.0) << " frames/s; bag span "
-    << stats.bag_span_s << " s; real-time factor "
-    << (stats.wall_s > 0 ? stats.bag_span_s / stats.wall_s : 0.0) << "x\n"
-    << "outputs: " << args.out << "/{map.json, " << (map.geo_origin ? "map.geojson, " : "")
-    << "map_trajectory_tum.txt, summary.txt}"
-    << (args.stats_out.empty() ? "" : ", " + args.stats_out)
-    << (args.calibration_out.empty() ? "" : ", " + args.calibration_out) << "\n";
-  return s.str();
-}
-
 void WriteOutputs(const std::string& dir, const VectorMap& map,
                   const std::optional<GeoOrigin>& geo_origin, const std::string& summary) {
   const std::string note = SaveMapFiles(map, geo_origin, MapFilePathsInFolder(dir));
@@ -320,7 +178,7 @@ int Run(int argc, char** argv) {
     throw InputError(e.what());
   }
   if (!fs::is_regular_file(args.bag)) throw InputError(args.bag + ": no such bag file");
-  RunStats stats;
+  BagRunStats stats;
   OpenedBag opened;  // the bag, or the indexed copy of one without its index
   if (const std::string error = opened.Open(args.bag, args.out); !error.empty()) {
     throw InputError(error);
@@ -402,7 +260,9 @@ int Run(int argc, char** argv) {
   if (stats.salvage) map.metadata["index"] = IndexLine(stats).substr(7);
   map.geo_origin = config.geo_origin;   // recorded in map.json; the GeoJSON needs it
   map.frame_id = config.ros.map_frame;  // the live nodelet's frame for the same config
-  const std::string summary = Summary(args, mapper, session.assembler(), map, stats);
+  const BagRunPaths paths{args.bag, args.config,    args.classes,
+                          args.out, args.stats_out, args.calibration_out};
+  const std::string summary = BagRunSummary(paths, mapper, session.assembler(), map, stats);
   try {
     if (frame_stats) frame_stats->Close();
     if (publish_probe) publish_probe->Close();

@@ -4,11 +4,37 @@
 //   rosrun ipm_road_mapper mapper_node [__name:=<name>]
 //
 // Parameters, topics and services are those of the nodelet (docs/ros_api.md), in the
-// node's private namespace. Exit status 1 when the nodelet refuses its parameters.
+// node's private namespace. `--help` (or -h) prints this usage and exits 0 without
+// starting a node. Exit status 1 when the nodelet refuses its parameters.
 #include <nodelet/loader.h>
 #include <ros/ros.h>
 
+#include <cstring>
+#include <iostream>
+
+namespace {
+
+// True when the command line asks for the usage.
+bool WantsHelp(int argc, char** argv) {
+  for (int i = 1; i < argc; ++i) {
+    if (std::strcmp(argv[i], "--help") == 0 || std::strcmp(argv[i], "-h") == 0) return true;
+  }
+  return false;
+}
+
+}  // namespace
+
 int main(int argc, char** argv) {
+  if (WantsHelp(argc, argv)) {
+    std::cout
+        << "usage: rosrun ipm_road_mapper mapper_node [__name:=<name>] [<topic>:=<topic> ...]\n\n"
+           "Runs the MapperNodelet as a standalone node (a roscore must run). It takes no "
+           "options: its parameters (rosparam load config/mapper.yaml /ipm_road_mapper),\n"
+           "topics, services and their defaults are those of the nodelet, in the node's "
+           "private namespace: docs/ros_api.md.\n\n"
+           "options:\n  -h [ --help ]   print this help and exit\n";
+    return 0;
+  }
   ros::init(argc, argv, "ipm_road_mapper");
   // No manager services: this process hosts exactly this nodelet.
   nodelet::Loader loader(false);

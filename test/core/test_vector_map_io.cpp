@@ -1,7 +1,6 @@
-// Map and ground-truth JSON files: round trips, atomic writes, deterministic bytes, and the
-// one-line MapFormatError for every kind of bad file.
+// Map JSON files: round trips, atomic writes, and the one-line MapFormatError for every
+// kind of bad file; the pose JSON and the TUM trajectory. Ground truth: test_ground_truth_io.
 #include <gtest/gtest.h>
-#include <unistd.h>
 
 #include <cmath>
 #include <cstdio>
@@ -13,77 +12,12 @@
 #include <sstream>
 #include <string>
 
+#include "common/file_test_utils.h"
 #include "ipm_road_mapper/core/io/ground_truth.h"
 #include "ipm_road_mapper/core/map/vector_map.h"
 
 namespace ipm_road_mapper {
 namespace {
-
-namespace fs = std::filesystem;
-
-// A fresh temporary folder per test, removed afterwards.
-class MapIoTest : public ::testing::Test {
- protected:
-  void SetUp() override {
-    char pattern[] = "/tmp/irm_map_io_XXXXXX";
-    ASSERT_NE(mkdtemp(pattern), nullptr);
-    dir_ = pattern;
-  }
-  void TearDown() override { fs::remove_all(dir_); }
-  std::string Path(const std::string& name) const { return dir_ + "/" + name; }
-
-  std::string dir_;
-};
-
-Eigen::Isometry3d MakePose(double x, double y, double z, double roll, double pitch, double yaw) {
-  Eigen::Isometry3d T = Eigen::Isometry3d::Identity();
-  T.linear() = RotationFromRpy(roll, pitch, yaw);
-  T.translation() = Eigen::Vector3d(x, y, z);
-  return T;
-}
-
-VectorMap MakeMap() {
-  VectorMap map;
-  MapMarking marking;
-  marking.id = 7;
-  marking.class_id = 10;
-  marking.class_name = "arrow_straight";
-  marking.corners_map = {Eigen::Vector3d(10.1, -1.2, 0.013), Eigen::Vector3d(10.1, -0.6, 0.014),
-                         Eigen::Vector3d(14.9, -0.6, 0.021), Eigen::Vector3d(14.9, -1.2, 0.02)};
-  marking.observations = 12;
-  marking.first_seen = 1700000000.05;
-  marking.last_seen = 1700000001.55;
-  map.markings.push_back(marking);
-  marking.id = 18446744073709551615ULL;                 // the largest id must survive too
-  marking.sides_measured = {true, false, true, false};  // a crossing wider than the view
-  map.markings.push_back(marking);
-  MapLane lane;
-  lane.id = 3;
-  lane.class_id = 2;
-  lane.class_name = "lane_white_dashed";
-  lane.style = "dashed";
-  for (int k = 0; k < 6; ++k) {
-    lane.control_points_map.emplace_back(3.0 * k - 3.0, 1.75 + 0.01 * k * k, 0.001 * k);
-  }
-  lane.observations = 40;
-  map.lanes.push_back(lane);
-  map.T_base_cam = MakePose(1.5, 0.02, 1.4, -M_PI / 2 - 0.01, 0.003, -M_PI / 2 + 0.02);
-  map.T_base_cam_initial = MakePose(1.5, 0.0, 1.45, -M_PI / 2, 0.0, -M_PI / 2);
-  for (int i = 0; i < 6; ++i) {
-    for (int k = 0; k < 6; ++k)
-      map.T_base_cam_covariance(i, k) = (i == k ? 1e-4 : 1e-6) * (1 + i + 7 * k);
-  }
-  map.T_base_cam_observed = {true, true, false, false, true, true};
-  for (int k = 0; k < 3; ++k) {
-    map.trajectory.push_back({1700000000.0 + 0.05 * k, MakePose(k, 0.1 * k, 0.0, 0, 0, 0.01 * k)});
-  }
-  map.metadata = {{"method", "Ours(+PPSR)"}, {"frames", 3}};
-  return map;
-}
-
-void ExpectPoseNear(const Eigen::Isometry3d& a, const Eigen::Isometry3d& b, double tolerance) {
-  EXPECT_LT((a.matrix() - b.matrix()).cwiseAbs().maxCoeff(), tolerance);
-}
 
 void ExpectMapsEqual(const VectorMap& a, const VectorMap& b) {
   EXPECT_EQ(a.frame_id, b.frame_id);
@@ -120,17 +54,6 @@ void ExpectMapsEqual(const VectorMap& a, const VectorMap& b) {
     ExpectPoseNear(a.trajectory[i].T_map_base, b.trajectory[i].T_map_base, 1e-9);
   }
   EXPECT_EQ(a.metadata, b.metadata);
-}
-
-std::string ReadFile(const std::string& path) {
-  std::ifstream in(path, std::ios::binary);
-  std::ostringstream s;
-  s << in.rdbuf();
-  return s.str();
-}
-
-void WriteFile(const std::string& path, const std::string& text) {
-  std::ofstream(path, std::ios::binary) << text;
 }
 
 // Loading `text` as a map must throw MapFormatError with a one-line message containing
@@ -320,105 +243,6 @@ TEST_F(MapIoTest, TumTrajectoryHasOneLinePerPose) {
     ++count;
   }
   EXPECT_EQ(count, map.trajectory.size());
-}
-
-GroundTruth MakeGroundTruth() {
-  GroundTruth gt;
-  gt.scenario = "straight_2lanes";
-  gt.seed = 4000000000u;
-  gt.frame_rate_hz = 20.0;
-  gt.camera.width = 1280;
-  gt.camera.height = 720;
-  gt.camera.fx = gt.camera.fy = 1000.0;
-  gt.camera.cx = 640.0;
-  gt.camera.cy = 360.0;
-  gt.camera.distortion = {-0.1, 0.01, 0.0, 0.0, 1e-7};
-  gt.T_base_cam_true = MakePose(1.5, 0.0, 1.4, -M_PI / 2 - 0.05, 0.0, -M_PI / 2);
-  gt.T_base_cam_rough = MakePose(1.5, 0.0, 1.45, -M_PI / 2, 0.0, -M_PI / 2);
-  GroundTruthMarking marking;
-  marking.id = 1;
-  marking.class_id = 10;
-  marking.class_name = "arrow_straight";
-  marking.corners_map = {Eigen::Vector3d(10, -1, 0.01), Eigen::Vector3d(10, -0.5, 0.01),
-                         Eigen::Vector3d(15, -0.5, 0.02), Eigen::Vector3d(15, -1, 0.02)};
-  marking.center_map = Eigen::Vector3d(12.5, -0.75, 0.015);
-  marking.visible_frames = 31;
-  gt.markings.push_back(marking);
-  GroundTruthLane lane;
-  lane.id = 2;
-  lane.class_id = 1;
-  lane.class_name = "lane_white_solid";
-  lane.style = "solid";
-  for (int k = 0; k <= 100; ++k) lane.points_map.emplace_back(0.1 * k, 1.75, 1e-4 * k / 3.0);
-  gt.lanes.push_back(lane);
-  for (int k = 0; k < 5; ++k) {
-    GroundTruthFrame frame;
-    frame.stamp = 1700000000.0 + k / 20.0;
-    frame.T_map_base_true = MakePose(0.5 * k, 0.0, 0.0, 0.0, 0.001 * k, 0.0);
-    frame.T_map_base_odom = MakePose(0.5 * k + 0.1 / 3.0, 0.02, 0.0, 0.0, 0.0, 0.003 * k);
-    gt.frames.push_back(frame);
-  }
-  return gt;
-}
-
-TEST_F(MapIoTest, GroundTruthRoundTripAndDeterministicBytes) {
-  const GroundTruth gt = MakeGroundTruth();
-  SaveGroundTruthJson(gt, Path("gt1.json"));
-  SaveGroundTruthJson(gt, Path("gt2.json"));
-  const std::string bytes = ReadFile(Path("gt1.json"));
-  EXPECT_EQ(bytes, ReadFile(Path("gt2.json")));
-  // Rounded numbers print short (1.55, never 1.5499999999999998): at most 9 decimals.
-  std::smatch long_number;
-  EXPECT_FALSE(std::regex_search(bytes, long_number, std::regex(R"([0-9]\.[0-9]{10,})")))
-      << long_number.str();
-
-  const GroundTruth loaded = LoadGroundTruthJson(Path("gt1.json"));
-  EXPECT_EQ(loaded.scenario, gt.scenario);
-  EXPECT_EQ(loaded.seed, gt.seed);
-  EXPECT_EQ(loaded.frame_rate_hz, gt.frame_rate_hz);
-  EXPECT_EQ(loaded.camera.width, gt.camera.width);
-  EXPECT_EQ(loaded.camera.distortion, gt.camera.distortion);
-  ExpectPoseNear(loaded.T_base_cam_true, gt.T_base_cam_true, 1e-6);
-  ExpectPoseNear(loaded.T_base_cam_rough, gt.T_base_cam_rough, 1e-6);
-  ASSERT_EQ(loaded.markings.size(), 1u);
-  EXPECT_EQ(loaded.markings[0].visible_frames, 31);
-  EXPECT_EQ(loaded.markings[0].class_name, "arrow_straight");
-  EXPECT_LT((loaded.markings[0].center_map - gt.markings[0].center_map).norm(), 1e-6);
-  for (int k = 0; k < 4; ++k) {
-    EXPECT_LT((loaded.markings[0].corners_map[k] - gt.markings[0].corners_map[k]).norm(), 1e-6);
-  }
-  ASSERT_EQ(loaded.lanes.size(), 1u);
-  ASSERT_EQ(loaded.lanes[0].points_map.size(), gt.lanes[0].points_map.size());
-  for (std::size_t k = 0; k < gt.lanes[0].points_map.size(); ++k) {
-    EXPECT_LT((loaded.lanes[0].points_map[k] - gt.lanes[0].points_map[k]).norm(), 1e-6);
-  }
-  ASSERT_EQ(loaded.frames.size(), gt.frames.size());
-  for (std::size_t k = 0; k < gt.frames.size(); ++k) {
-    EXPECT_NEAR(loaded.frames[k].stamp, gt.frames[k].stamp, 1e-9);
-    ExpectPoseNear(loaded.frames[k].T_map_base_true, gt.frames[k].T_map_base_true, 1e-6);
-    ExpectPoseNear(loaded.frames[k].T_map_base_odom, gt.frames[k].T_map_base_odom, 1e-6);
-  }
-  // Saving what was loaded gives the same bytes again (rounding is idempotent).
-  SaveGroundTruthJson(loaded, Path("gt3.json"));
-  EXPECT_EQ(bytes, ReadFile(Path("gt3.json")));
-}
-
-TEST_F(MapIoTest, BadGroundTruthFilesThrow) {
-  GroundTruth gt = MakeGroundTruth();
-  SaveGroundTruthJson(gt, Path("gt.json"));
-  const std::string good = ReadFile(Path("gt.json"));
-  WriteFile(Path("truncated.json"), good.substr(0, good.size() - 20));
-  EXPECT_THROW(LoadGroundTruthJson(Path("truncated.json")), MapFormatError);
-  EXPECT_THROW(LoadGroundTruthJson(Path("missing.json")), MapFormatError);
-  nlohmann::json j = nlohmann::json::parse(good);
-  j["markings"][0].erase("visible_frames");
-  WriteFile(Path("no_visibility.json"), j.dump());
-  EXPECT_THROW(LoadGroundTruthJson(Path("no_visibility.json")), MapFormatError);
-  // A map is not a ground truth.
-  SaveVectorMapJson(MakeMap(), Path("map.json"));
-  EXPECT_THROW(LoadGroundTruthJson(Path("map.json")), MapFormatError);
-  gt.lanes[0].points_map[3].z() = std::numeric_limits<double>::infinity();
-  EXPECT_THROW(SaveGroundTruthJson(gt, Path("gt_inf.json")), std::runtime_error);
 }
 
 }  // namespace

@@ -36,7 +36,7 @@ class FakeWorker {
  public:
   void Set(int markings, std::uint64_t version, std::uint64_t resets) {
     auto snapshot = std::make_shared<MapSnapshot>();
-    snapshot->map = std::make_shared<const VectorMap>(MapWith(markings));
+    snapshot->map = std::make_shared<const SharedVectorMap>(ShareVectorMap(MapWith(markings)));
     snapshot->map_version = version;
     snapshot->resets = resets;
     std::lock_guard<std::mutex> lock(mutex_);

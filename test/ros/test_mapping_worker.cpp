@@ -94,8 +94,8 @@ TEST(MappingWorker, MapsInItsThreadAndPublishesSnapshots) {
   ASSERT_TRUE(WaitForSnapshot(
       worker, [](const MapSnapshot& s) { return s.map && s.status.counters.frames_used == 10; }));
   const auto snapshot = worker.Latest();
-  EXPECT_EQ(snapshot->map->frame_id, "map");  // as map_from_bag's map.json
-  EXPECT_EQ(snapshot->map->trajectory.size(), 10u);
+  EXPECT_EQ(snapshot->map->header.frame_id, "map");  // as map_from_bag's map.json
+  EXPECT_EQ(snapshot->map->header.trajectory.size(), 10u);
   EXPECT_EQ(snapshot->refined_camera_frame, "camera_refined");
   EXPECT_NEAR(snapshot->newest_frame_stamp, 0.95, 1e-9);
   EXPECT_EQ(updates.load(), 10);
@@ -148,13 +148,13 @@ TEST(MappingWorker, ResetIsACommandOfTheMappingThread) {
   MappingWorker worker(Config(), Classes(), "test", kNoTf, {});
   Feed(&worker, 5);
   ASSERT_TRUE(WaitForSnapshot(
-      worker, [](const MapSnapshot& s) { return s.map && s.map->trajectory.size() == 5; }));
+      worker, [](const MapSnapshot& s) { return s.map && s.map->header.trajectory.size() == 5; }));
   EXPECT_EQ(worker.Latest()->resets, 0u);
   std::string message;
   EXPECT_TRUE(worker.Reset(2.0, &message)) << message;
   const auto after = worker.Latest();  // swapped in before Reset returned
   ASSERT_NE(after->map, nullptr);
-  EXPECT_TRUE(after->map->trajectory.empty());
+  EXPECT_TRUE(after->map->header.trajectory.empty());
   EXPECT_EQ(after->resets, 1u);  // the generation the saver files post-reset maps by
 }
 
@@ -186,7 +186,7 @@ TEST(MappingWorker, SnapshotsShareTheFrozenTrajectoryAndSavesGetItWhole) {
   const auto snapshot = worker.Latest();
   // 1300 frames are out of every window: one 1000-pose chunk frozen, the rest in the map.
   ASSERT_EQ(snapshot->trajectory_prefix.size(), 1u);
-  EXPECT_EQ(snapshot->map->trajectory.size(), kFrames - 1000u);
+  EXPECT_EQ(snapshot->map->header.trajectory.size(), kFrames - 1000u);
   const auto full = snapshot->FullMap();
   ASSERT_EQ(full->trajectory.size(), static_cast<std::size_t>(kFrames));
   for (std::size_t i = 0; i < full->trajectory.size(); ++i) {
@@ -224,15 +224,15 @@ TEST(MapSnapshot, FullMapLinksTheLaneTopologyTheSnapshotSkips) {
     l.observations = 3;
     return l;
   };
-  auto map = std::make_shared<VectorMap>();
-  map->lanes = {lane(1, 0.0), lane(2, 20.0)};  // 2 starts where 1 ends
+  VectorMap map;
+  map.lanes = {lane(1, 0.0), lane(2, 20.0)};  // 2 starts where 1 ends
   MapSnapshot snapshot;
-  snapshot.map = map;
+  snapshot.map = std::make_shared<const SharedVectorMap>(ShareVectorMap(map));
   const std::shared_ptr<const VectorMap> full = snapshot.FullMap();
   ASSERT_EQ(full->lanes.size(), 2u);
   EXPECT_EQ(full->lanes[0].successors, std::vector<std::uint64_t>{2});
   EXPECT_EQ(full->lanes[1].predecessors, std::vector<std::uint64_t>{1});
-  EXPECT_TRUE(snapshot.map->lanes[0].successors.empty());  // the snapshot's own map untouched
+  EXPECT_TRUE(snapshot.map->lanes[0]->successors.empty());  // the snapshot's own map untouched
 }
 
 }  // namespace

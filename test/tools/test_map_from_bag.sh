@@ -252,14 +252,15 @@ if [ "$help_rc" -ne 0 ] || [ -s "$work/help.err" ]; then
   fail "--help: exit $help_rc, stderr: $(cat "$work/help.err")"
 else
   missing=""
-  for option in --bag --config --classes --async --out --stats-out --publish-stats-out --help; do
+  for option in --bag --config --classes --async --out --stats-out --publish-stats-out \
+    --calibration-out --help; do
     grep -q -- "$option" "$work/help.txt" || missing="$missing $option"
   done
   described=$(grep -o -e "(default: " -e "(required)" "$work/help.txt" | wc -l)
   if [ -n "$missing" ]; then
     fail "--help does not name:$missing"
-  elif [ "$described" -lt 6 ]; then
-    fail "--help gives a default (or 'required') for $described of the 6 options"
+  elif [ "$described" -lt 8 ]; then
+    fail "--help gives a default (or 'required') for $described of the 8 options"
   else
     pass "--help names every option with its default, exit 0"
   fi

@@ -19,6 +19,7 @@
 #include <optional>
 #include <string>
 
+#include "ipm_road_mapper/core/map/shared_vector_map.h"
 #include "ipm_road_mapper/core/map/vector_map.h"
 #include "ipm_road_mapper/core/mapper/map_changes.h"
 #include "ipm_road_mapper/ros/marker_builder.h"
@@ -49,8 +50,9 @@ class MapPublisher {
   // time).
   // `changes` (optional): the core's changes of `map` since the revision of the last map
   // published or an older one (MapChanges): the delta and the changed markers are then
-  // built from them, at a cost that follows what changed; the full sets still from `map`.
-  PublishCounts Publish(const VectorMap& map, const std::string& map_frame,
+  // built from them, at a cost that follows what changed; the full sets still from `map`
+  // (copied out of its shared storage only then).
+  PublishCounts Publish(const SharedVectorMap& map, const std::string& map_frame,
                         const std::string& base_frame, const std::string& refined_camera_frame,
                         const ros::Time& stamp, bool map_changed = true,
                         const MapChanges* changes = nullptr);

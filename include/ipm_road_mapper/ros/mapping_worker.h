@@ -20,7 +20,9 @@
 #include <string>
 #include <thread>
 
+#include "ipm_road_mapper/core/map/shared_vector_map.h"
 #include "ipm_road_mapper/core/map/vector_map.h"
+#include "ipm_road_mapper/core/mapper/snapshot_cache.h"
 #include "ipm_road_mapper/pipeline/bounded_input_queue.h"
 #include "ipm_road_mapper/pipeline/extrinsic_source.h"
 #include "ipm_road_mapper/pipeline/frozen_trajectory.h"
@@ -32,13 +34,16 @@
 namespace ipm_road_mapper {
 
 // What the timers and services read; immutable once swapped in. Its cost does not grow with
-// the drive: `map` holds only the newest poses of the trajectory (those a solve may still
-// correct, at least ros/path_max_poses), the older ones are the frozen chunks that every
-// snapshot shares; FullMap() joins them for a save.
+// the drive: `map`'s elements sit in shared immutable storage (Mapper::ExportSnapshot: a
+// snapshot rebuilds only the parts that changed since the previous one), its header holds
+// only the newest poses of the trajectory (those a solve may still correct, at least
+// ros/path_max_poses), the older ones are the frozen chunks that every snapshot shares;
+// FullMap() joins them for a save.
 struct MapSnapshot {
-  std::shared_ptr<const VectorMap> map;  // with the nodelet's metadata; nullptr before start
-  TrajectoryChunks trajectory_prefix;    // the poses before map->trajectory
-  std::uint64_t map_version = 0;         // changes whenever the map may have changed
+  // With the nodelet's frame and metadata in its header; nullptr before start.
+  std::shared_ptr<const SharedVectorMap> map;
+  TrajectoryChunks trajectory_prefix;  // the poses before map->header.trajectory
+  std::uint64_t map_version = 0;       // changes whenever the map may have changed
   // The core's changes of `map` since the revision the publisher last acknowledged
   // (MappingWorker::Published; everything before that): what the delta and the changed
   // markers are built from. nullptr before start.
@@ -125,9 +130,13 @@ class MappingWorker {
   // Runs the pending ~reset; true when the thread is to end (stop or finish done).
   bool RunCommands();
   void RunFinish(Clock::time_point deadline);
-  // The map with the trajectory after the frozen prefix (freezing more of what no window
-  // solve changes any more), or with the whole trajectory exported afresh.
-  std::shared_ptr<VectorMap> ExportMap(bool whole_trajectory);
+  // The snapshot's map: the elements through snapshot_cache_, the trajectory after the frozen
+  // prefix (freezing more of what no window solve changes any more).
+  std::shared_ptr<const SharedVectorMap> ExportSnapshotMap();
+  // The finished map: every element, the whole trajectory exported afresh, the topology.
+  std::shared_ptr<const VectorMap> ExportFinishedMap() const;
+  // The nodelet's frame and metadata on an export.
+  void Label(VectorMap* map) const;
   MapperStatusSnapshot Status() const;
 
   const MapperConfig config_;
@@ -145,8 +154,9 @@ class MappingWorker {
   std::uint64_t generation_ = 0;  // resets run
   bool status_dirty_ = true;
   double newest_frame_stamp_ = 0.0;
-  std::shared_ptr<const VectorMap> exported_map_;
+  std::shared_ptr<const SharedVectorMap> exported_map_;
   std::shared_ptr<const MapChanges> exported_changes_;  // of exported_map_
+  SnapshotCache snapshot_cache_;                        // what exported_map_ shares
   FrozenTrajectory frozen_trajectory_;                  // the poses no solve changes any more
   TrajectoryChunks exported_prefix_;  // frozen_trajectory_'s chunks as of exported_map_
   Clock::time_point next_export_, last_overlay_;

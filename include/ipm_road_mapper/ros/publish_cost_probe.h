@@ -3,7 +3,9 @@
 // builds ~vector_map_delta and the changed ~markers as MapPublisher does, from the core's
 // incremental export (Mapper::ExportChanges), and, for comparison, the old way from the
 // whole exported map (fingerprints of every element), and the nodelet's snapshot export
-// (ExportMap without the lane topology). Thread CPU of each step goes to a CSV row
+// (Mapper::ExportSnapshot, through a SnapshotCache kept along the drive as the nodelet's
+// mapping thread keeps it) beside the snapshot export before it (ExportMap without the lane
+// topology, every element copied). Thread CPU of each step goes to a CSV row
 // (flushed: a run stopped early keeps its rows). ExportMap with the topology (what the
 // snapshot cost before: 0.66 s at 10 km) is left out: timing it would distort the run's
 // own CPU per frame. Only the first
@@ -28,7 +30,7 @@ class PublishCostProbe {
   // The CSV columns, in order.
   static constexpr const char* kHeader =
       "km,frame,stamp,markings,lanes,changed_elements,export_changes_ms,export_snapshot_ms,"
-      "publish_ms,publish_old_ms";
+      "publish_ms,publish_old_ms,export_snapshot_old_ms";
 
   // Writes to `path` (throws std::runtime_error when it cannot be opened); publishes every
   // 1 / `publish_rate_hz` s of bag time (> 0).
@@ -56,6 +58,7 @@ class PublishCostProbe {
   std::uint64_t revision_ = 0;
   VectorMapDeltaBuilder deltas_, old_deltas_;
   MarkerBuilder markers_, old_markers_;
+  SnapshotCache snapshots_;  // as the nodelet's mapping thread keeps it
 };
 
 }  // namespace ipm_road_mapper

@@ -13,6 +13,10 @@ void ChangeLog::NoteRemoved(ElementKind kind, std::uint64_t id) {
   log.emplace_back(Next(), id);
 }
 
+void ChangeLog::NoteRetiredMoved(std::size_t index) {
+  retired_moved_.emplace_back(Next(), static_cast<std::uint64_t>(index));
+}
+
 std::vector<ChangeLog::Entry>::const_iterator ChangeLog::After(const std::vector<Entry>& log,
                                                                std::uint64_t since) {
   return std::upper_bound(log.begin(), log.end(), since,
@@ -32,11 +36,20 @@ std::vector<std::uint64_t> ChangeLog::RemovedSince(ElementKind kind, std::uint64
   return ids;
 }
 
+std::vector<std::size_t> ChangeLog::RetiredMovedSince(std::uint64_t since) const {
+  std::vector<std::size_t> slots;
+  for (auto it = After(retired_moved_, since); it != retired_moved_.end(); ++it) {
+    slots.push_back(static_cast<std::size_t>(it->second));
+  }
+  return slots;
+}
+
 void ChangeLog::Clear() {
   cleared_at_ = Next();
   retired_.clear();
   removed_markings_.clear();
   removed_lanes_.clear();
+  retired_moved_.clear();
 }
 
 }  // namespace ipm_road_mapper

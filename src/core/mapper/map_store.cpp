@@ -92,7 +92,10 @@ std::size_t MapStore::ReviveMarking(std::size_t retired_index) {
   std::vector<MarkingElement>& retired = map_.retired_markings;
   map_.markings.push_back(std::move(retired[retired_index]));
   noted_marking_ids_.insert(map_.markings.back().id);  // in the map: its removal is news
-  if (retired_index + 1 != retired.size()) retired[retired_index] = std::move(retired.back());
+  if (retired_index + 1 != retired.size()) {
+    retired[retired_index] = std::move(retired.back());
+    changes_.NoteRetiredMoved(retired_index);  // an export's order there changed
+  }
   retired.pop_back();
   ReindexRetiredMarkings();
   return map_.markings.size() - 1;

@@ -190,7 +190,7 @@ bool Mapper::ExportLane(const LaneElement& element, MapLane* lane) const {
 
 VectorMap Mapper::ExportMap(const ExportOptions& export_options) const {
   VectorMap out;
-  ExportExtrinsic(&out);
+  ExportHeader(export_options.max_trajectory_poses, nullptr, &out);
   for (const auto* markings : {&store_.markings(), &store_.retired_markings()}) {
     for (const MarkingElement& m : *markings) {
       MapMarking marking;
@@ -202,34 +202,47 @@ VectorMap Mapper::ExportMap(const ExportOptions& export_options) const {
     if (ExportLane(element, &lane)) out.lanes.push_back(std::move(lane));
   }
   if (export_options.lane_topology) LinkLaneTopology(&out.lanes);
+  return out;
+}
+
+void Mapper::ExportHeader(std::size_t max_poses, SnapshotCache* cache, VectorMap* out) const {
+  ExportExtrinsic(out);
   const std::vector<FrameRecord>& frames = store_.frames();
-  const std::size_t max_poses = export_options.max_trajectory_poses;
   const std::size_t first =
       max_poses > 0 && frames.size() > max_poses ? frames.size() - max_poses : 0;
-  out.trajectory.reserve(frames.size() - first);
+  out->trajectory.reserve(frames.size() - first);
   for (std::size_t i = first; i < frames.size(); ++i) {
-    out.trajectory.push_back({frames[i].stamp, store_.CorrectedPose(i)});
+    out->trajectory.push_back({frames[i].stamp, store_.CorrectedPose(i)});
   }
-  out.metadata["method"] = options_.method;
-  out.metadata["frames_received"] = counters_.frames_received;
-  out.metadata["frames_used"] = counters_.frames_used;
-  out.metadata["frames_skipped"] = counters_.frames_skipped;
-  out.metadata["backend"] = windows_.enabled() ? ToString(options_.backend.lane_residual) : "off";
-  out.metadata["backend_results_applied"] = counters_.results_applied;
-  out.metadata["backend_results_rejected"] = counters_.results_rejected;
-  out.metadata["backend_extrinsic_rejected"] = counters_.extrinsic_rejected;
-  out.metadata["frontend_time_p50_ms"] = Quantile(frontend_timing_.total_ms, 0.5);
-  out.metadata["frontend_time_p95_ms"] = Quantile(frontend_timing_.total_ms, 0.95);
-  out.metadata["frontend_extraction_p50_ms"] = Quantile(frontend_timing_.extraction_ms, 0.5);
+  nlohmann::json& metadata = out->metadata;
+  metadata["method"] = options_.method;
+  metadata["frames_received"] = counters_.frames_received;
+  metadata["frames_used"] = counters_.frames_used;
+  metadata["frames_skipped"] = counters_.frames_skipped;
+  metadata["backend"] = windows_.enabled() ? ToString(options_.backend.lane_residual) : "off";
+  metadata["backend_results_applied"] = counters_.results_applied;
+  metadata["backend_results_rejected"] = counters_.results_rejected;
+  metadata["backend_extrinsic_rejected"] = counters_.extrinsic_rejected;
+  const std::vector<float>& total_ms = frontend_timing_.total_ms;
+  const std::vector<float>& extraction_ms = frontend_timing_.extraction_ms;
+  metadata["frontend_time_p50_ms"] =
+      cache ? cache->frontend_p50.Update(total_ms) : Quantile(total_ms, 0.5);
+  metadata["frontend_time_p95_ms"] =
+      cache ? cache->frontend_p95.Update(total_ms) : Quantile(total_ms, 0.95);
+  metadata["frontend_extraction_p50_ms"] =
+      cache ? cache->extraction_p50.Update(extraction_ms) : Quantile(extraction_ms, 0.5);
   if (windows_.enabled()) {
     const BackendStats stats = windows_.stats();
-    out.metadata["backend_solves"] = stats.solved;
-    out.metadata["backend_dropped_queue_full"] = stats.dropped_queue_full;
-    out.metadata["backend_solve_time_p50_s"] = Quantile(stats.solve_times_s, 0.5);
-    out.metadata["backend_solve_time_p95_s"] = Quantile(stats.solve_times_s, 0.95);
-    out.metadata["backend_solve_time_max_s"] = Quantile(stats.solve_times_s, 1.0);
+    const std::vector<double>& solve_s = stats.solve_times_s;
+    metadata["backend_solves"] = stats.solved;
+    metadata["backend_dropped_queue_full"] = stats.dropped_queue_full;
+    metadata["backend_solve_time_p50_s"] =
+        cache ? cache->solve_p50.Update(solve_s) : Quantile(solve_s, 0.5);
+    metadata["backend_solve_time_p95_s"] =
+        cache ? cache->solve_p95.Update(solve_s) : Quantile(solve_s, 0.95);
+    metadata["backend_solve_time_max_s"] =
+        cache ? cache->solve_max.Update(solve_s) : Quantile(solve_s, 1.0);
   }
-  return out;
 }
 
 }  // namespace ipm_road_mapper

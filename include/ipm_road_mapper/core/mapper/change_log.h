@@ -1,9 +1,11 @@
 // The map's revisions: a counter the MapStore bumps on every change of an element's exported
-// form (MapStore::Touch), and the two logs an incremental export needs so that it never
-// scans the retired markings: which retired markings changed at which revision, and which
-// element ids left the map at which revision. Both logs are appended in revision order.
+// form (MapStore::Touch), and the logs an incremental export needs so that it never scans
+// the retired markings: which retired markings changed at which revision, which element ids
+// left the map at which revision, and which retired slots another marking moved into (what
+// a shared snapshot's chunks follow). The logs are appended in revision order.
 #pragma once
 
+#include <cstddef>
 #include <cstdint>
 #include <utility>
 #include <vector>
@@ -23,12 +25,17 @@ class ChangeLog {
   void NoteRetired(std::uint64_t revision, std::uint64_t id);
   // Element `id` of `kind` left the map; gets a new revision.
   void NoteRemoved(ElementKind kind, std::uint64_t id);
+  // Retired marking slot `index` (an index into the retired markings) holds another marking
+  // now (MapStore::ReviveMarking moved the last one there); gets a new revision.
+  void NoteRetiredMoved(std::size_t index);
 
   // The (revision, id) entries of retired markings noted after `since`, oldest first; an
   // id may appear more than once (the caller keeps the entry matching its revision).
   std::vector<std::pair<std::uint64_t, std::uint64_t>> RetiredSince(std::uint64_t since) const;
   // The ids of `kind` removed after `since`, in removal order.
   std::vector<std::uint64_t> RemovedSince(ElementKind kind, std::uint64_t since) const;
+  // The retired marking slots noted moved after `since`, oldest first.
+  std::vector<std::size_t> RetiredMovedSince(std::uint64_t since) const;
 
   // Everything before now is forgotten (a reset): revisions keep counting, and a request
   // for changes since an older revision must take the whole map (cleared_at()).
@@ -45,6 +52,7 @@ class ChangeLog {
   std::uint64_t cleared_at_ = 0;
   std::vector<Entry> retired_;
   std::vector<Entry> removed_markings_, removed_lanes_;
+  std::vector<Entry> retired_moved_;  // (revision, slot)
 };
 
 }  // namespace ipm_road_mapper

@@ -18,6 +18,7 @@
 #include "ipm_road_mapper/core/backend/backend.h"
 #include "ipm_road_mapper/core/frontend/class_table.h"
 #include "ipm_road_mapper/core/geometry/pinhole_camera.h"
+#include "ipm_road_mapper/core/map/shared_vector_map.h"
 #include "ipm_road_mapper/core/map/vector_map.h"
 #include "ipm_road_mapper/core/mapper/lane_tracker.h"
 #include "ipm_road_mapper/core/mapper/map_changes.h"
@@ -26,6 +27,7 @@
 #include "ipm_road_mapper/core/mapper/mapper_options.h"
 #include "ipm_road_mapper/core/mapper/marking_tracker.h"
 #include "ipm_road_mapper/core/mapper/skip_reason.h"
+#include "ipm_road_mapper/core/mapper/snapshot_cache.h"
 #include "ipm_road_mapper/core/mapper/window_coordinator.h"
 
 namespace ipm_road_mapper {
@@ -95,6 +97,12 @@ class Mapper {
   // revision `since` (0: all of them), and the ids it no longer exports. Costs the live
   // markings, the lanes and what changed; retired markings only when they changed.
   MapChanges ExportChanges(std::uint64_t since) const;
+  // The live snapshot's export (what ExportMap gives with `max_trajectory_poses` newest
+  // poses and no lane topology), in shared immutable storage: only the live markings, the
+  // retired-marking chunks with a slot changed since the last call with `cache`, and the
+  // lanes whose revision changed are built anew; the rest is `cache`'s, shared. Its cost
+  // follows what changed, not the map's length (mapper_snapshot.cpp).
+  SharedVectorMap ExportSnapshot(std::size_t max_trajectory_poses, SnapshotCache* cache) const;
   // The map's revision now (MapChanges::revision).
   std::uint64_t revision() const { return store_.changes().revision(); }
 
@@ -148,6 +156,10 @@ class Mapper {
   std::string ClassName(int class_id) const;
   // The extrinsic fields of an export.
   void ExportExtrinsic(VectorMap* out) const;
+  // Every field of an export but its elements: the extrinsic, the trajectory's newest
+  // `max_trajectory_poses` poses (0: all) and the metadata, its timing quantiles through
+  // `cache` when given (the same values, at the cost of the samples added since).
+  void ExportHeader(std::size_t max_trajectory_poses, SnapshotCache* cache, VectorMap* out) const;
 
   // Declaration order is construction order: the rooms hold pointers to what precedes them.
   const MapperOptions options_;
