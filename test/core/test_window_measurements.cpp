@@ -59,6 +59,7 @@ TEST(CollectLanePixels, AssignsAPixelBeyondACrestToTheSegmentItsRayMeets) {
   const WindowSnapshot snapshot = CrestSnapshot(x_true);
   BackendOptions options;
   options.max_lane_points_per_observation = 100;
+  options.lane_pixels_on_lane_surface = true;
   window_solve::WindowState state(snapshot);
   window_solve::CollectLanePixels(snapshot, options, &state);
   // Flat-ground IPM puts the pixel at 31 m about 6 m too far, and 0.7 m sideways: it was

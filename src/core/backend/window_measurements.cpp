@@ -152,11 +152,12 @@ void CollectLanePixels(const WindowSnapshot& snapshot, const BackendOptions& opt
         if (ipm.PixelToGround(point.uv, &p_base) != IpmStatus::kOk) continue;
         Eigen::Vector3d p_map = T_map_base * p_base;
         CatmullRomSpline::ClosestPoint closest = spline.FindClosest(p_map);
-        if (!OntoLaneSurface(camera, T_map_base * snapshot.T_base_cam, T_map_base, point.uv, spline,
+        if (closest.distance_m > options.max_lane_pixel_distance_m) continue;
+        if (options.lane_pixels_on_lane_surface &&
+            !OntoLaneSurface(camera, T_map_base * snapshot.T_base_cam, T_map_base, point.uv, spline,
                              &p_map, &closest)) {
           continue;
         }
-        if (closest.distance_m > options.max_lane_pixel_distance_m) continue;
         if (closest.s <= 0.0 || closest.s >= spline.NumSegments()) continue;  // past an end
         const auto& cps = lane.control_points_map;
         if (!ProjectsNearImage(camera, *state, slot->second, cps[closest.segment + 1],
