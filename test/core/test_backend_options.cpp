@@ -68,6 +68,11 @@ TEST(BackendOptions, GatesKeepTheirFormerDefaults) {
   const BackendOptions o = LoadFrom("{}");
   EXPECT_EQ(o.max_lane_pixel_distance_m, 1.5);
   EXPECT_EQ(o.max_outside_image_px, 100.0);
+  EXPECT_FALSE(o.lane_pixels_on_lane_surface);
+  EXPECT_TRUE(LoadFrom("{lane_pixels_on_lane_surface: true}").lane_pixels_on_lane_surface);
+  EXPECT_NE(ToString(LoadFrom("{lane_pixels_on_lane_surface: true}"))
+                .find("backend.lane_pixels_on_lane_surface: true\n"),
+            std::string::npos);
 }
 
 TEST(BackendOptions, GatesAreReadAndValidated) {
@@ -124,6 +129,7 @@ TEST(BackendOptions, ShippedMapperYamlKeepsTheDefaults) {
   EXPECT_EQ(o.robust_kernel, ParseRobustKernel(backend["robust_kernel"].as<std::string>()));
   EXPECT_EQ(o.max_lane_pixel_distance_m, defaults.max_lane_pixel_distance_m);
   EXPECT_EQ(o.max_outside_image_px, defaults.max_outside_image_px);
+  EXPECT_EQ(o.lane_pixels_on_lane_surface, defaults.lane_pixels_on_lane_surface);
   EXPECT_EQ(o.extrinsic_min_information_ratio, defaults.extrinsic_min_information_ratio);
   EXPECT_EQ(o.extrinsic_prior_memory_markings, defaults.extrinsic_prior_memory_markings);
   EXPECT_EQ(o.extrinsic_holdout_every_n_frames, defaults.extrinsic_holdout_every_n_frames);

@@ -116,6 +116,7 @@ BackendOptions LoadBackendOptions(OptionsReader reader) {
   reader.Read<int>("max_lane_points_per_observation", &o.max_lane_points_per_observation,
                    CheckPositiveInt);
   reader.Read<double>("max_lane_pixel_distance_m", &o.max_lane_pixel_distance_m, CheckPositive);
+  reader.Read<bool>("lane_pixels_on_lane_surface", &o.lane_pixels_on_lane_surface);
   reader.Read<double>("max_outside_image_px", &o.max_outside_image_px, CheckNonNegative);
   reader.Read<int>("max_measurements_per_marking", &o.max_measurements_per_marking,
                    [](const int& v) { return v >= 2 ? "" : "must be >= 2"; });
@@ -185,6 +186,8 @@ std::string ToString(const BackendOptions& o) {
     << k << "extrinsic_holdout_sigmas: " << o.extrinsic_holdout_sigmas << "\n"
     << k << "max_lane_points_per_observation: " << o.max_lane_points_per_observation << "\n"
     << k << "max_lane_pixel_distance_m: " << o.max_lane_pixel_distance_m << "\n"
+    << k << "lane_pixels_on_lane_surface: " << (o.lane_pixels_on_lane_surface ? "true" : "false")
+    << "\n"
     << k << "max_outside_image_px: " << o.max_outside_image_px << "\n"
     << k << "max_measurements_per_marking: " << o.max_measurements_per_marking << "\n"
     << k << "road_height_sigma_m: " << o.road_height_sigma_m << "\n"

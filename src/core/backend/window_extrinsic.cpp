@@ -4,8 +4,6 @@
 #include <vector>
 
 #include "ipm_road_mapper/core/backend/residuals/corner_reprojection_residual.h"
-#include "ipm_road_mapper/core/backend/residuals/motion_prior_residual.h"
-#include "ipm_road_mapper/core/backend/residuals/pose_prior_residual.h"
 #include "ipm_road_mapper/core/backend/residuals/ppsr_residual.h"
 #include "ipm_road_mapper/core/backend/window_map_step.h"
 
@@ -47,41 +45,10 @@ void ObserveExtrinsic(const WindowSnapshot& snapshot, const BackendOptions& opti
     return;
   }
   AddMapPointPriors(options, state, &problem);
-  for (std::size_t i = 0; i < state->frames.size(); ++i) {
-    PoseBlocks& pose = state->frames[i];
-    if (!problem.HasParameterBlock(pose.q)) continue;
-    problem.SetManifold(pose.q, new ceres::EigenQuaternionManifold);
-    if (!snapshot.frames[i].in_window) {
-      problem.SetParameterBlockConstant(pose.q);
-      problem.SetParameterBlockConstant(pose.t);
-      continue;
-    }
-    problem.AddResidualBlock(
-        residuals::PosePriorResidual::Create(snapshot.frames[i].T_map_base_odom,
-                                             options.pose_prior_sigma_trans_m,
-                                             options.pose_prior_sigma_rot_rad),
-        nullptr, pose.q, pose.t);
-  }
-  if (options.motion_prior) {
-    for (std::size_t i = 1; i + 1 < state->frames.size(); ++i) {
-      const WindowFrame& a = snapshot.frames[i - 1];
-      const WindowFrame& b = snapshot.frames[i];
-      const WindowFrame& c = snapshot.frames[i + 1];
-      if (b.index != a.index + 1 || c.index != b.index + 1 || !b.in_window) continue;
-      if (!problem.HasParameterBlock(state->frames[i - 1].q) ||
-          !problem.HasParameterBlock(state->frames[i].q) ||
-          !problem.HasParameterBlock(state->frames[i + 1].q)) {
-        continue;
-      }
-      const double dt_a = b.stamp - a.stamp, dt_b = c.stamp - b.stamp;
-      if (!(dt_a > 0.0) || !(dt_b > 0.0)) continue;
-      PoseBlocks &pa = state->frames[i - 1], &pb = state->frames[i], &pc = state->frames[i + 1];
-      problem.AddResidualBlock(
-          residuals::MotionPriorResidual::Create(dt_a, dt_b, options.motion_sigma_acc_mps2,
-                                                 options.motion_sigma_angular_acc_radps2),
-          nullptr, pa.q, pa.t, pb.q, pb.t, pc.q, pc.t);
-    }
-  }
+  // The window's poses marginalized as in the pose step: on their odometry priors and under
+  // the motion prior (context frames are data).
+  AddPosePriors(snapshot, options, state, &problem);
+  AddMotionPriors(snapshot, options, MotionPriorTriples::kAllInProblem, state, &problem);
   problem.SetManifold(q_bc, new ceres::EigenQuaternionManifold);
   state->observability = AnalyzeObservability(
       ExtrinsicInformation(&problem, q_bc, t_bc, {}),

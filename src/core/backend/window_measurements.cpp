@@ -75,6 +75,59 @@ void CollectCornerMeasurements(const WindowSnapshot& snapshot, const BackendOpti
   }
 }
 
+namespace {
+
+// Re-intersections of a lane pixel's ray with the lane's own surface (OntoLaneSurface).
+constexpr int kLaneSurfaceIterations = 3;
+
+// A lane closer than this (sine of the angle) to the viewing frame's lateral axis gives no
+// lane surface (LaneSurfaceNormal).
+constexpr double kMinLaneSurfaceSine = 0.3;
+
+// The plane through the lane's point `closest` that holds the lane's direction there and the
+// viewing frame's lateral axis (its cross slope); the frame's own road plane when the lane
+// runs across the frame's heading.
+Eigen::Vector3d LaneSurfaceNormal(const CatmullRomSpline& spline,
+                                  const CatmullRomSpline::ClosestPoint& closest,
+                                  const Eigen::Isometry3d& T_map_base) {
+  const Eigen::Vector3d normal = spline.Derivative(closest.s).cross(T_map_base.linear().col(1));
+  const double norm = normal.norm();
+  if (!(norm > kMinLaneSurfaceSine * spline.Derivative(closest.s).norm())) {
+    return T_map_base.linear().col(2);
+  }
+  return normal.z() >= 0.0 ? Eigen::Vector3d(normal / norm) : Eigen::Vector3d(-normal / norm);
+}
+
+// Moves a lane pixel's ground point from the viewing frame's road plane onto the lane's own
+// surface (LaneSurfaceNormal through its closest point) and finds the closest point again,
+// kLaneSurfaceIterations times. Why: on a grade change, a crest or a wave the road ahead is
+// not in the viewing frame's plane (0.3 m off at 20 m on a crest from +6 % to -4 %);
+// flat-ground IPM then puts the pixel meters along and, scaled by its lateral offset,
+// sideways from its line, so it was matched to the wrong segment (its PPSR measured the
+// distance to a wrong chord of the projected line) or dropped by the distance gate, the far
+// line on one side more than the others: a bias of the camera's roll on hills. The lane's
+// height is the map's own estimate (under the road-surface prior). False when the ray does
+// not meet that surface ahead of the camera.
+bool OntoLaneSurface(const PinholeCamera& camera, const Eigen::Isometry3d& T_map_cam,
+                     const Eigen::Isometry3d& T_map_base, const Eigen::Vector2d& uv,
+                     const CatmullRomSpline& spline, Eigen::Vector3d* p_map,
+                     CatmullRomSpline::ClosestPoint* closest) {
+  const Eigen::Vector2d xy = camera.UndistortToNormalized(uv);
+  const Eigen::Vector3d ray_map = T_map_cam.linear() * Eigen::Vector3d(xy.x(), xy.y(), 1.0);
+  for (int iteration = 0; iteration < kLaneSurfaceIterations; ++iteration) {
+    const Eigen::Vector3d normal_map = LaneSurfaceNormal(spline, *closest, T_map_base);
+    const double descent = normal_map.dot(ray_map);
+    if (descent >= 0.0) return false;
+    const double lambda = normal_map.dot(closest->point - T_map_cam.translation()) / descent;
+    if (lambda <= 0.0) return false;
+    *p_map = T_map_cam.translation() + lambda * ray_map;
+    *closest = spline.FindClosest(*p_map);
+  }
+  return true;
+}
+
+}  // namespace
+
 void CollectLanePixels(const WindowSnapshot& snapshot, const BackendOptions& options,
                        WindowState* state) {
   const PinholeCamera camera(snapshot.camera);
@@ -97,9 +150,14 @@ void CollectLanePixels(const WindowSnapshot& snapshot, const BackendOptions& opt
         const LanePoint& point = m.points[selected[static_cast<std::size_t>(k)]];
         Eigen::Vector3d p_base;
         if (ipm.PixelToGround(point.uv, &p_base) != IpmStatus::kOk) continue;
-        const Eigen::Vector3d p_map = T_map_base * p_base;
-        const CatmullRomSpline::ClosestPoint closest = spline.FindClosest(p_map);
+        Eigen::Vector3d p_map = T_map_base * p_base;
+        CatmullRomSpline::ClosestPoint closest = spline.FindClosest(p_map);
         if (closest.distance_m > options.max_lane_pixel_distance_m) continue;
+        if (options.lane_pixels_on_lane_surface &&
+            !OntoLaneSurface(camera, T_map_base * snapshot.T_base_cam, T_map_base, point.uv, spline,
+                             &p_map, &closest)) {
+          continue;
+        }
         if (closest.s <= 0.0 || closest.s >= spline.NumSegments()) continue;  // past an end
         const auto& cps = lane.control_points_map;
         if (!ProjectsNearImage(camera, *state, slot->second, cps[closest.segment + 1],

@@ -2,8 +2,6 @@
 
 #include "ipm_road_mapper/core/backend/residuals/corner_reprojection_residual.h"
 #include "ipm_road_mapper/core/backend/residuals/edge_reprojection_residual.h"
-#include "ipm_road_mapper/core/backend/residuals/motion_prior_residual.h"
-#include "ipm_road_mapper/core/backend/residuals/pose_prior_residual.h"
 #include "ipm_road_mapper/core/backend/residuals/ppsr_residual.h"
 
 namespace ipm_road_mapper {
@@ -73,38 +71,9 @@ ceres::Solver::Summary PoseStep(const WindowSnapshot& snapshot, const BackendOpt
     return ceres::Solver::Summary();
   }
   // The motion prior over consecutive frames (by index) that touch a free pose; the others
-  // of a triple join as data.
-  if (options.motion_prior) {
-    for (std::size_t i = 1; i + 1 < state->frames.size(); ++i) {
-      const WindowFrame& a = snapshot.frames[i - 1];
-      const WindowFrame& b = snapshot.frames[i];
-      const WindowFrame& c = snapshot.frames[i + 1];
-      if (b.index != a.index + 1 || c.index != b.index + 1) continue;
-      if (!problem.HasParameterBlock(state->frames[i].q)) continue;  // no data on the middle one
-      const double dt_a = b.stamp - a.stamp, dt_b = c.stamp - b.stamp;
-      if (!(dt_a > 0.0) || !(dt_b > 0.0)) continue;
-      PoseBlocks &pa = state->frames[i - 1], &pb = state->frames[i], &pc = state->frames[i + 1];
-      problem.AddResidualBlock(
-          residuals::MotionPriorResidual::Create(dt_a, dt_b, options.motion_sigma_acc_mps2,
-                                                 options.motion_sigma_angular_acc_radps2),
-          nullptr, pa.q, pa.t, pb.q, pb.t, pc.q, pc.t);
-    }
-  }
-  for (std::size_t i = 0; i < state->frames.size(); ++i) {
-    PoseBlocks& pose = state->frames[i];
-    if (!problem.HasParameterBlock(pose.q)) continue;
-    if (!snapshot.frames[i].in_window) {  // a context frame: data
-      problem.SetParameterBlockConstant(pose.q);
-      problem.SetParameterBlockConstant(pose.t);
-      continue;
-    }
-    problem.AddResidualBlock(
-        residuals::PosePriorResidual::Create(snapshot.frames[i].T_map_base_odom,
-                                             options.pose_prior_sigma_trans_m,
-                                             options.pose_prior_sigma_rot_rad),
-        nullptr, pose.q, pose.t);
-    problem.SetManifold(pose.q, new ceres::EigenQuaternionManifold);
-  }
+  // of a triple join as data. Then every pose's odometry prior (context frames: data).
+  AddMotionPriors(snapshot, options, MotionPriorTriples::kMiddleInProblem, state, &problem);
+  AddPosePriors(snapshot, options, state, &problem);
   const ceres::Solver::Summary summary = Solve(options, state->step_time_limit_s, &problem);
   if (summary.IsSolutionUsable()) RecordPoseStep(snapshot, &problem, state);
   return summary;

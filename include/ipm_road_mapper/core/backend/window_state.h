@@ -113,6 +113,23 @@ struct WindowState {
 bool ProjectsNearImage(const PinholeCamera& camera, const WindowState& state, std::size_t slot,
                        const Eigen::Vector3d& p_map, double margin_px);
 
+// The odometry prior of every window frame whose pose is in `problem` (PosePriorResidual on
+// T_map_base_odom, pose_prior_sigma_*), its rotation on the quaternion manifold; a context
+// frame's pose (not in_window) is held constant instead (data).
+void AddPosePriors(const WindowSnapshot& snapshot, const BackendOptions& options,
+                   WindowState* state, ceres::Problem* problem);
+
+// Which consecutive triples of frames (by index) get the motion prior (AddMotionPriors).
+enum class MotionPriorTriples {
+  kMiddleInProblem,  // the middle pose is in the problem; the other two join (pose step)
+  kAllInProblem,     // all three poses are in the problem and the middle one is in the window
+};
+
+// The motion prior (MotionPriorResidual, motion_sigma_*) over the triples `triples` selects;
+// nothing without options.motion_prior.
+void AddMotionPriors(const WindowSnapshot& snapshot, const BackendOptions& options,
+                     MotionPriorTriples triples, WindowState* state, ceres::Problem* problem);
+
 // The robust kernel of the measurement residuals (BackendOptions::robust_kernel); nullptr
 // for none. The problem it is given to owns it.
 ceres::LossFunction* MakeLoss(const BackendOptions& options);

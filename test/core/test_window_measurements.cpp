@@ -1,0 +1,81 @@
+// The window's lane pixels: each is assigned to the spline segment where its ray meets the
+// lane, also where the road ahead is not in the viewing frame's plane (a crest).
+#include <gtest/gtest.h>
+
+#include <cmath>
+
+#include "common/test_scene.h"
+#include "ipm_road_mapper/core/backend/window_measurements.h"
+#include "ipm_road_mapper/core/backend/window_state.h"
+#include "ipm_road_mapper/core/geometry/pinhole_camera.h"
+
+namespace ipm_road_mapper {
+namespace {
+
+constexpr double kDeg = M_PI / 180.0;
+
+// The height of a road over a crest (+6 % grade turning at 0.1 %/m): z(x) = 0.06 x -
+// 0.0005 x^2, i.e. 0.8 m below the viewing frame's plane at 40 m.
+double CrestHeight(double x_m) { return 0.06 * x_m - 0.0005 * x_m * x_m; }
+
+// A lane at y_m beside the path, its control points on the crest every 3 m from -6 m to 60 m.
+WindowLane LaneOverCrest(double y_m) {
+  WindowLane lane;
+  for (double x = -6.0; x <= 60.0; x += 3.0) {
+    lane.control_points_map.emplace_back(x, y_m, CrestHeight(x));
+  }
+  return lane;
+}
+
+// One frame at the origin on the crest's first slope (nose up: its base plane has the 6 %
+// grade), seeing the lane at 3.5 m to the left.
+WindowSnapshot CrestSnapshot(const std::vector<double>& x_on_lane_m) {
+  WindowSnapshot snapshot;
+  snapshot.camera = test::Intrinsics1280x720();
+  snapshot.T_base_cam = test::MountedCamera(0.0, 4.0 * kDeg, 0.0, Eigen::Vector3d(1.5, 0.0, 1.5));
+  WindowFrame frame;
+  frame.index = 7;
+  frame.T_map_base.linear() = RotationFromRpy(0.0, -std::atan(0.06), 0.0);
+  snapshot.frames.push_back(frame);
+  WindowLane lane = LaneOverCrest(3.5);
+  const PinholeCamera camera(snapshot.camera);
+  const Eigen::Isometry3d T_cam_map = (frame.T_map_base * snapshot.T_base_cam).inverse();
+  LaneMeasurement measurement;
+  measurement.frame_index = frame.index;
+  for (double x : x_on_lane_m) {
+    LanePoint point;
+    EXPECT_TRUE(camera.Project(Eigen::Vector3d(T_cam_map * Eigen::Vector3d(x, 3.5, CrestHeight(x))),
+                               &point.uv));
+    measurement.points.push_back(point);
+    measurement.selected.push_back(1);
+  }
+  lane.measurements.push_back(measurement);
+  snapshot.lanes.push_back(lane);
+  return snapshot;
+}
+
+TEST(CollectLanePixels, AssignsAPixelBeyondACrestToTheSegmentItsRayMeets) {
+  const std::vector<double> x_true = {12.0, 16.5, 25.0, 31.0};
+  const WindowSnapshot snapshot = CrestSnapshot(x_true);
+  BackendOptions options;
+  options.max_lane_points_per_observation = 100;
+  options.lane_pixels_on_lane_surface = true;
+  window_solve::WindowState state(snapshot);
+  window_solve::CollectLanePixels(snapshot, options, &state);
+  // Flat-ground IPM puts the pixel at 31 m about 6 m too far, and 0.7 m sideways: it was
+  // given the segment two chords on, or dropped by the 1.5 m gate.
+  ASSERT_EQ(state.lane_pixels.size(), x_true.size());
+  for (std::size_t i = 0; i < x_true.size(); ++i) {
+    const window_solve::LanePixel& pixel = state.lane_pixels[i];
+    // Control point k + 1 is the segment's start: x = -6 + 3 (segment + 1).
+    const double x_start = -6.0 + 3.0 * (pixel.segment + 1);
+    EXPECT_LE(x_start, x_true[i] + 1e-6) << "pixel at x = " << x_true[i];
+    EXPECT_GE(x_start + 3.0, x_true[i] - 1e-6) << "pixel at x = " << x_true[i];
+    EXPECT_NEAR(pixel.q_map.x(), x_true[i], 0.05);
+    EXPECT_NEAR(pixel.q_map.y(), 3.5, 0.05);
+    EXPECT_NEAR(pixel.q_map.z(), CrestHeight(x_true[i]), 0.01);
+  }
+}
+
+}  // namespace
+}  // namespace ipm_road_mapper
