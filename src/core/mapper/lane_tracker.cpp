@@ -106,8 +106,8 @@ void LaneTracker::Grow(LaneElement* lane, std::size_t frame_index,
     points.insert(points.end(), m->selected_map.begin(), m->selected_map.end());
   }
   int added_at_start = 0;
-  lane->control_points_map = FitLaneEnds(lane->control_points_map, points, options_.lanes.end_fit,
-                                         &added_at_start, &usable_map);
+  FitLaneEndsNear(options_.lanes.end_fit, points, usable_map, &lane->control_points_map,
+                  &added_at_start);
   lane->first_cp_index -= added_at_start;  // keeps older back-end results applicable
 }
 
