@@ -168,6 +168,22 @@ TEST(AssociateLanes, RejectsCrossingDirection) {
   EXPECT_LT(LaneAssociationCost(lanes[0], crossing, AssociationOptions()), 0.0);
 }
 
+// A whole lane as the candidate (the merge of two lanes): each of its points is compared with
+// the part of the lane near it, which decides as one piece around all of them would.
+TEST(LaneAssociationCost, WholeLanesKilometersLong) {
+  const AssociationOptions options;
+  const LaneElement lane = StraightLane(2, 0.0, 0, 3000);
+  EXPECT_GE(LaneAssociationCost(lane, LinePoints(2, 0.1, 1000, 2500), options), 0.0);
+  EXPECT_LT(LaneAssociationCost(lane, LinePoints(2, 3.5, 0, 3000), options), 0.0);  // beside
+  // Two thirds of it 30 m beside the lane (farther than any part near a point): no match.
+  LaneCandidate bent = LinePoints(2, 0.1, 0, 1000);
+  const LaneCandidate away = LinePoints(2, 30.0, 1000, 3000);
+  bent.points_map.insert(bent.points_map.end(), away.points_map.begin(), away.points_map.end());
+  EXPECT_LT(LaneAssociationCost(lane, bent, options), 0.0);
+  // Past the lane's end within the end gap: still the lane.
+  EXPECT_GE(LaneAssociationCost(lane, LinePoints(2, 0.1, 2000, 3010), options), 0.0);
+}
+
 TEST(AssociationOptions, RejectsUnknownAndBadKeys) {
   EXPECT_THROW(LoadAssociationOptions(OptionsReader(YAML::Load("lane_gate: 1.0"), "association")),
                OptionsError);

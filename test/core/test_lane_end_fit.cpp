@@ -129,3 +129,59 @@ TEST(FitLaneEnds, IgnoresNonFinitePointsAndRejectsShortLanes) {
 
 }  // namespace
 }  // namespace ipm_road_mapper
+
+// FitLaneEndsNear: the whole-lane result from the part near the points, on a lane 3 km long
+// (growth at the end past a gap, growth at the start, a refit of the middle).
+namespace ipm_road_mapper {
+namespace {
+
+std::vector<Eigen::Vector3d> WavyControlPoints(double x0, double x1) {
+  std::vector<Eigen::Vector3d> cps;
+  for (double x = x0 - 3.0; x <= x1 + 3.0 + 1e-9; x += 3.0) {
+    cps.emplace_back(x, 0.5 * std::sin(x / 50.0), 0.0);
+  }
+  return cps;
+}
+
+void ExpectSameFit(const std::vector<Eigen::Vector3d>& cps,
+                   const std::vector<Eigen::Vector3d>& points,
+                   const std::vector<Eigen::Vector3d>& growth) {
+  int added_whole = -1, added_near = -1;
+  const auto whole = FitLaneEnds(cps, points, LaneEndFitOptions(), &added_whole, &growth);
+  std::vector<Eigen::Vector3d> near = cps;
+  FitLaneEndsNear(LaneEndFitOptions(), points, growth, &near, &added_near);
+  EXPECT_EQ(added_near, added_whole);
+  ASSERT_EQ(near.size(), whole.size());
+  for (std::size_t j = 0; j < whole.size(); ++j) {
+    EXPECT_LT((near[j] - whole[j]).norm(), 1e-9) << "control point " << j;
+  }
+}
+
+TEST(FitLaneEndsNear, EqualsTheWholeLaneFitAtTheEndPastAGap) {
+  const auto cps = WavyControlPoints(0.0, 3000.0);
+  std::mt19937 rng(3);
+  // The recent observations near the end, 0.3 m off (a tail to pull), and growth points
+  // starting 12 m past the end (a dash gap) reaching 20 m beyond it.
+  const auto points = LinePoints(2985.0, 2999.0, 0.3, 0.5, 0.02, &rng);
+  const auto growth = LinePoints(3012.0, 3020.0, 0.3, 0.5, 0.02, &rng);
+  ExpectSameFit(cps, points, points);
+  ExpectSameFit(cps, points, growth);
+  std::vector<Eigen::Vector3d> near = cps;
+  int added = 0;
+  FitLaneEndsNear(LaneEndFitOptions(), points, growth, &near, &added);
+  EXPECT_GT(near.size(), cps.size());                                            // it grew
+  for (std::size_t j = 0; j + 20 < cps.size(); ++j) EXPECT_EQ(near[j], cps[j]);  // untouched
+}
+
+TEST(FitLaneEndsNear, EqualsTheWholeLaneFitAtTheStartAndInTheMiddle) {
+  const auto cps = WavyControlPoints(0.0, 3000.0);
+  std::mt19937 rng(4);
+  const auto start = LinePoints(-9.0, 6.0, 0.2, 0.5, 0.02, &rng);  // 9 m before the start
+  ExpectSameFit(cps, start, start);
+  const auto middle = LinePoints(1500.0, 1515.0, 0.2, 0.5, 0.02, &rng);
+  ExpectSameFit(cps, middle, middle);
+  ExpectSameFit(cps, {}, {});  // nothing near: unchanged
+}
+
+}  // namespace
+}  // namespace ipm_road_mapper

@@ -65,6 +65,37 @@ TEST(LaneTracker, TwoLanesAlongOneLineAreMerged) {
   EXPECT_EQ(rig.store.lanes()[0].history.size(), 3u);  // both histories and the new frame
 }
 
+// Lanes kilometers long (joined lines on a long drive): the merge compares each with the
+// part of the other near its points, and still merges only two lanes along one line.
+TEST(LaneTracker, LongLanesMergeAlongOneLineOnly) {
+  MapperOptions options;
+  options.lanes.merge_every_n_frames = 1;
+  Rig rig(options);
+  auto straight = [&](double y, double x0, double x1) {
+    LaneElement lane;
+    lane.id = rig.store.NewId();
+    lane.class_id = 1;  // not the scene's dashed line
+    for (double x = x0 - 3.0; x <= x1 + 3.0 + 1e-9; x += 3.0) {
+      lane.control_points_map.emplace_back(x, y, 0.0);
+    }
+    return lane;
+  };
+  rig.store.lanes().push_back(straight(-30.0, 0.0, 3000.0));
+  rig.store.lanes().push_back(straight(-29.9, 1500.0, 4500.0));  // the same line, 1.5 km on
+  rig.store.lanes().push_back(straight(-26.5, 0.0, 3000.0));     // the next line, 3.5 m beside
+  rig.Step(RoadFrame(100.0, 0.0, false));
+  EXPECT_EQ(rig.counters.lanes_merged, 1u);
+  std::size_t on_the_line = 0, beside = 0;
+  for (const LaneElement& lane : rig.store.lanes()) {
+    if (lane.class_id != 1) continue;
+    const double y = lane.control_points_map[1].y();
+    if (std::abs(y + 30.0) < 0.5) ++on_the_line;
+    if (std::abs(y + 26.5) < 0.5) ++beside;
+  }
+  EXPECT_EQ(on_the_line, 1u);
+  EXPECT_EQ(beside, 1u);
+}
+
 // Two fragments of one dashed line across a gap: lane 1 seen in frames 0-39, lane 2 from
 // frame 60 on.
 void AddFragments(Rig* rig) {

@@ -4,6 +4,7 @@
 #include <cmath>
 #include <limits>
 #include <opencv2/imgproc.hpp>
+#include <optional>
 #include <tuple>
 
 #include "ipm_road_mapper/core/frontend/partial_view_association.h"
@@ -99,6 +100,42 @@ double RectangleArea(const std::array<Eigen::Vector3d, 4>& c) {
 
 }  // namespace
 
+namespace {
+
+// A candidate whose points span more than this (m, horizontally) is compared with the lane
+// near each point rather than with one piece of the lane around all of them.
+constexpr double kMaxSharedCurveExtentM = 100.0;
+
+// The part of a lane's curve near some points: a sub-spline, and whether it holds the lane's
+// start and end.
+struct LocalCurve {
+  CatmullRomSpline spline;
+  bool has_start = false;
+  bool has_end = false;
+};
+
+std::optional<LocalCurve> LocalCurveNear(const std::vector<Eigen::Vector3d>& cps,
+                                         const std::vector<Eigen::Vector3d>& points,
+                                         double margin_m) {
+  std::size_t first = 0, last = 0;
+  if (!ControlPointRangeNear(cps, points, margin_m, &first, &last)) return std::nullopt;
+  return LocalCurve{
+      CatmullRomSpline(std::vector<Eigen::Vector3d>(cps.begin() + first, cps.begin() + last + 1)),
+      first == 0, last + 1 == cps.size()};
+}
+
+// Whether the points' horizontal bounding box is wider or longer than `extent_m`.
+bool IsSpread(const std::vector<Eigen::Vector3d>& points, double extent_m) {
+  Eigen::Vector2d lo = points.front().head<2>(), hi = lo;
+  for (const Eigen::Vector3d& p : points) {
+    lo = lo.cwiseMin(p.head<2>());
+    hi = hi.cwiseMax(p.head<2>());
+  }
+  return ((hi - lo).array() > extent_m).any();
+}
+
+}  // namespace
+
 double MarkingFloorSigma(const AssociationOptions& options) {
   return std::hypot(options.marking_position_sigma_m, options.odometry_sigma_m);
 }
@@ -190,15 +227,15 @@ double LaneAssociationCost(const LaneElement& lane, const LaneCandidate& candida
   const double gate_m =
       std::max(options.lane_gate_m, options.lane_gate_sigmas * LaneFloorSigma(options));
   // Only the part of the lane near the observation (a lane can be kilometers long); the
-  // margin covers points past an end that still count.
-  std::size_t first = 0, last = 0;
-  if (!ControlPointRangeNear(lane.control_points_map, points, options.lane_max_end_gap_m + 5.0,
-                             &first, &last)) {
-    return -1.0;
+  // margin covers points past an end that still count. A candidate longer than an
+  // observation (a whole lane, when lanes are merged) gets the part near each of its points,
+  // so that the cost does not grow with the lanes' lengths.
+  const double margin_m = options.lane_max_end_gap_m + 5.0;
+  std::optional<LocalCurve> shared;
+  if (!IsSpread(points, kMaxSharedCurveExtentM)) {
+    shared = LocalCurveNear(lane.control_points_map, points, margin_m);
+    if (!shared) return -1.0;
   }
-  const CatmullRomSpline spline(std::vector<Eigen::Vector3d>(
-      lane.control_points_map.begin() + first, lane.control_points_map.begin() + last + 1));
-  const bool has_start = first == 0, has_end = last + 1 == lane.control_points_map.size();
   // Observation direction: from its first to its last point (ordered along the lane).
   Eigen::Vector2d obs_dir = (points.back() - points.front()).head<2>();
   if (obs_dir.norm() < 1e-6) return -1.0;
@@ -209,16 +246,31 @@ double LaneAssociationCost(const LaneElement& lane, const LaneCandidate& candida
   const std::size_t step = std::max<std::size_t>(1, n / 12);
   std::vector<double> lateral, normalized;
   int used = 0, direction_votes = 0, direction_ok = 0;
-  const double end_s = spline.NumSegments();
   for (std::size_t i = 0; i < n; i += step, ++used) {
     const Eigen::Vector3d& p = points[i];
+    std::optional<LocalCurve> own;
+    if (!shared) {
+      own = LocalCurveNear(lane.control_points_map, {p}, margin_m);
+      if (!own) {
+        // Farther than the margin from the whole lane: beside it, as with one shared piece.
+        lateral.push_back(std::numeric_limits<double>::infinity());
+        normalized.push_back(std::numeric_limits<double>::infinity());
+        ++direction_votes;
+        ++direction_ok;
+        continue;
+      }
+    }
+    const LocalCurve& curve = shared ? *shared : *own;
+    const CatmullRomSpline& spline = curve.spline;
     const CatmullRomSpline::ClosestPoint closest = spline.FindClosest(p);
     Eigen::Vector2d tangent = spline.Derivative(closest.s).head<2>();
     if (tangent.norm() < 1e-9) continue;
     tangent.normalize();
     const Eigen::Vector2d offset = (p - closest.point).head<2>();
     const double along = offset.dot(tangent);
-    const bool at_end = (has_start && closest.s <= 1e-6) || (has_end && closest.s >= end_s - 1e-6);
+    const double end_s = spline.NumSegments();
+    const bool at_end =
+        (curve.has_start && closest.s <= 1e-6) || (curve.has_end && closest.s >= end_s - 1e-6);
     if (at_end && std::abs(along) > options.lane_max_end_gap_m) continue;
     // Past an end, the lateral distance is measured to the end tangent line.
     const double lateral_m =

@@ -15,6 +15,11 @@ constexpr int kReweightRounds = 3;
 // A point whose closest curve point is an end counts for refinement only this close to it
 // (farther, it lies beyond the end: extension material, not a sample of the curve).
 constexpr double kEndSnapM = 0.05;
+// The slice FitLaneEndsNear hands to FitLaneEnds: the control points within this of the
+// points (an end beyond an association gap included) and this many more on each side, so
+// that the slice's own ends (phantoms to FitLaneEnds) are never moved or grown.
+constexpr double kSliceReachM = 50.0;
+constexpr std::size_t kSliceMarginPoints = 4;
 
 // Catmull-Rom basis weights of c_i..c_(i+3) at u (see catmull_rom_spline.h).
 Eigen::Vector4d Basis(double u) {
@@ -224,6 +229,44 @@ std::vector<Eigen::Vector3d> FitLaneEnds(const std::vector<Eigen::Vector3d>& con
   if (free[1] || free[2]) cps.front() = 2.0 * cps[1] - cps[2];
   if (free[n - 2] || free[n - 3]) cps.back() = 2.0 * cps[n - 2] - cps[n - 3];
   return cps;
+}
+
+void FitLaneEndsNear(const LaneEndFitOptions& options, const std::vector<Eigen::Vector3d>& points,
+                     const std::vector<Eigen::Vector3d>& extension_points,
+                     std::vector<Eigen::Vector3d>* cps, int* added_at_start) {
+  std::vector<Eigen::Vector3d> near = points;
+  near.insert(near.end(), extension_points.begin(), extension_points.end());
+  near.erase(std::remove_if(near.begin(), near.end(),
+                            [](const Eigen::Vector3d& p) { return !p.allFinite(); }),
+             near.end());
+  std::size_t first = 0, last = cps->size() - 1;
+  if (!near.empty() && ControlPointRangeNear(*cps, near, kSliceReachM, &first, &last)) {
+    first = first > kSliceMarginPoints ? first - kSliceMarginPoints : 0;
+    last = std::min(cps->size() - 1, last + kSliceMarginPoints);
+  } else {
+    first = 0;
+    last = cps->size() - 1;
+  }
+  const std::vector<Eigen::Vector3d> slice(cps->begin() + first, cps->begin() + last + 1);
+  int added = 0;
+  std::vector<Eigen::Vector3d> fitted =
+      FitLaneEnds(slice, points, options, &added, &extension_points);
+  const bool starts_inside = first > 0, ends_inside = last + 1 < cps->size();
+  // A slice end inside the lane must come back as it was (else: the whole lane, as before).
+  if ((starts_inside && (added != 0 || fitted.front() != slice.front())) ||
+      (ends_inside && (fitted.size() != slice.size() + static_cast<std::size_t>(added) ||
+                       fitted.back() != slice.back()))) {
+    *cps = FitLaneEnds(*cps, points, options, added_at_start, &extension_points);
+    return;
+  }
+  *added_at_start = added;
+  const std::size_t old_size = slice.size();
+  if (fitted.size() == old_size) {
+    std::copy(fitted.begin(), fitted.end(), cps->begin() + first);
+  } else {
+    cps->erase(cps->begin() + first, cps->begin() + last + 1);
+    cps->insert(cps->begin() + first, fitted.begin(), fitted.end());
+  }
 }
 
 }  // namespace ipm_road_mapper

@@ -46,6 +46,21 @@ std::vector<Eigen::Vector3d> UsablePoints(const LaneCandidate& candidate) {
   return usable_map;
 }
 
+// A lane as an association candidate for the merge: its real control points (ordered along
+// it), only the ones LaneAssociationCost would look at (it spreads about 12 over a
+// candidate), so that a pair's test does not copy two lanes kilometers long.
+LaneCandidate SampledCandidate(const LaneElement& lane) {
+  constexpr std::size_t kSamples = 12;
+  LaneCandidate candidate;
+  candidate.class_id = lane.class_id;
+  const std::vector<Eigen::Vector3d>& cps = lane.control_points_map;
+  if (cps.size() < 3) return candidate;
+  const std::size_t n = cps.size() - 2;  // phantom ends out
+  const std::size_t step = std::max<std::size_t>(1, n / kSamples);
+  for (std::size_t i = 0; i < n; i += step) candidate.points_map.push_back(cps[1 + i]);
+  return candidate;
+}
+
 }  // namespace
 
 LaneTracker::LaneTracker(const MapperOptions& options, MapStore* store, MapperCounters* counters)
@@ -106,8 +121,8 @@ void LaneTracker::Grow(LaneElement* lane, std::size_t frame_index,
     points.insert(points.end(), m->selected_map.begin(), m->selected_map.end());
   }
   int added_at_start = 0;
-  lane->control_points_map = FitLaneEnds(lane->control_points_map, points, options_.lanes.end_fit,
-                                         &added_at_start, &usable_map);
+  FitLaneEndsNear(options_.lanes.end_fit, points, usable_map, &lane->control_points_map,
+                  &added_at_start);
   lane->first_cp_index -= added_at_start;  // keeps older back-end results applicable
 }
 
@@ -189,11 +204,11 @@ void LaneTracker::MergeLines() {
     for (std::size_t b = a + 1; b < lanes.size();) {
       LaneElement& first = lanes[a];
       LaneElement& second = lanes[b];
-      LaneCandidate candidate;
-      candidate.class_id = second.class_id;
-      candidate.points_map = second.control_points_map;          // ordered along the lane
-      candidate.points_map.erase(candidate.points_map.begin());  // phantom ends out
-      candidate.points_map.pop_back();
+      if (first.class_id != second.class_id) {
+        ++b;
+        continue;
+      }
+      const LaneCandidate candidate = SampledCandidate(second);
       if (candidate.points_map.size() < 2 ||
           LaneAssociationCost(first, candidate, options_.association) < 0.0) {
         ++b;

@@ -50,4 +50,13 @@ std::vector<Eigen::Vector3d> FitLaneEnds(
     const LaneEndFitOptions& options, int* added_at_start = nullptr,
     const std::vector<Eigen::Vector3d>* extension_points = nullptr);
 
+// FitLaneEnds(*control_points, points, options, added_at_start, &extension_points) in place,
+// on the part of the lane near the points only: a lane can be kilometers long, and a frame
+// changes only its stretch near the recent observations (and grows an end there), so the
+// cost does not grow with the lane. The result is the whole-lane result (FitLaneEnds holds
+// every control point no point reaches); the whole lane is fit when the part would differ.
+void FitLaneEndsNear(const LaneEndFitOptions& options, const std::vector<Eigen::Vector3d>& points,
+                     const std::vector<Eigen::Vector3d>& extension_points,
+                     std::vector<Eigen::Vector3d>* control_points, int* added_at_start);
+
 }  // namespace ipm_road_mapper
