@@ -109,7 +109,11 @@ std::shared_ptr<const VectorMap> MappingWorker::Finish(Clock::time_point deadlin
   finish_requested_ = true;
   finish_deadline_ = deadline;
   queue_.Wake();
-  *finished = command_done_.wait_until(lock, deadline, [this] { return finish_done_; });
+  // Past the deadline the thread is inside one frame or the final solve's export; it hands
+  // over what it has within kFinishGrace (RunFinish), so the map saved is the map of every
+  // frame it used, not an older periodic snapshot.
+  command_done_.wait_until(lock, deadline + kFinishGrace, [this] { return finish_done_; });
+  *finished = finish_done_ && !finish_past_budget_;
   if (*finished) return finished_map_;
   lock.unlock();
   return Latest()->FullMap();
@@ -173,8 +177,17 @@ bool MappingWorker::RunCommands() {
 void MappingWorker::RunFinish(Clock::time_point deadline) {
   MapperInputItem item;
   while (Clock::now() < deadline && queue_.PopUntil(Clock::now(), &item)) Handle(item);
+  Export();  // Latest() holds every frame handled, whatever happens next
   std::shared_ptr<const VectorMap> map;
-  if (session_.started()) {
+  const bool past_budget = session_.started() && Clock::now() >= deadline;
+  if (past_budget) {
+    // The queue took the whole budget: no final solve; Finish saves Latest(), the map of
+    // every frame used (what was still queued is dropped with the inputs).
+    ROS_WARN(
+        "%s: the queued frames took the whole shutdown budget: the map is saved "
+        "without the final solve",
+        node_name_.c_str());
+  } else if (session_.started()) {
     const double budget_s = std::max(0.0, Seconds(deadline - Clock::now()).count());
     SessionUpdate update;
     session_.Finish(&update, budget_s);  // waiting frames decided, the last window solved
@@ -186,6 +199,7 @@ void MappingWorker::RunFinish(Clock::time_point deadline) {
   {
     std::lock_guard<std::mutex> lock(command_mutex_);
     finished_map_ = std::move(map);
+    finish_past_budget_ = past_budget;
     finish_done_ = true;
   }
   command_done_.notify_all();

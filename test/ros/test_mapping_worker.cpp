@@ -173,6 +173,25 @@ TEST(MappingWorker, FinishReturnsTheFinishedMapAndStopJoins) {
   worker.Stop();  // idempotent
 }
 
+// A Finish whose budget the queue outlasts returns the map of every frame the thread used
+// (the saved map and the final counters agree), not an older periodic snapshot, and keeps
+// within its grace (the frames still queued are dropped).
+TEST(MappingWorker, FinishPastTheBudgetSavesEveryFrameUsed) {
+  MappingWorker worker(Config(100000), Classes(), "test", kNoTf, {});
+  Feed(&worker, 1500);  // the snapshots, every 20 ms, lag the frames used
+  ASSERT_TRUE(WaitForSnapshot(
+      worker, [](const MapSnapshot& s) { return s.status.counters.frames_used > 0; }));
+  bool finished = true;
+  const auto start = Clock::now();
+  const auto map = worker.Finish(start, &finished);  // the budget is gone at once
+  EXPECT_LT(Clock::now() - start, MappingWorker::kFinishGrace + std::chrono::milliseconds(200));
+  EXPECT_FALSE(finished);
+  ASSERT_NE(map, nullptr);
+  worker.Stop();
+  const std::uint64_t used = worker.Latest()->status.counters.frames_used;
+  EXPECT_EQ(map->trajectory.size(), used);
+}
+
 TEST(MappingWorker, SnapshotsShareTheFrozenTrajectoryAndSavesGetItWhole) {
   MapperConfig config = Config(100000);
   config.ros.path_max_poses = 10;

@@ -109,11 +109,16 @@ class MappingWorker {
   // No more pushes (later ones are ignored); a waiting Reset answers at once.
   void CloseInputs();
 
-  // End of input: no more pushes; the thread maps what is queued, runs
-  // MappingSession::Finish with the time left until `deadline` and exports the map. Waits
-  // until then or `deadline`; returns the finished map (*finished = true) or else the
-  // latest snapshot's map (FullMap); nullptr when the session never started.
+  // End of input: no more pushes; the thread maps what is queued until `deadline`, then
+  // (if time is left) runs MappingSession::Finish with the rest and exports the map. Waits
+  // until then, or at most kFinishGrace past `deadline`; returns the finished map
+  // (*finished = true) or else the latest snapshot's map (FullMap), which holds every frame
+  // the thread used; nullptr when the session never started.
   std::shared_ptr<const VectorMap> Finish(Clock::time_point deadline, bool* finished);
+
+  // How long past its deadline Finish waits for the thread to hand over its map (one frame,
+  // or the final solve's export; ros/shutdown_budget_s + 1 s is the unload's bound).
+  static constexpr std::chrono::milliseconds kFinishGrace{500};
 
   // Stops and joins the mapping thread (idempotent); queued inputs are discarded.
   void Stop();
@@ -176,6 +181,7 @@ class MappingWorker {
   bool reset_requested_ = false, reset_running_ = false;
   std::uint64_t resets_done_ = 0;
   bool finish_requested_ = false, finish_done_ = false;
+  bool finish_past_budget_ = false;  // the queue took the budget: Latest() is the map
   Clock::time_point finish_deadline_;
   std::shared_ptr<const VectorMap> finished_map_;
 
