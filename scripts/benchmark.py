@@ -223,7 +223,7 @@ def main():
             real_absent = True
     extra = not args.quick  # noise sweep, seeds 2-3, the blob drive
 
-    # The drives (generated 2 at a time, cached by content).
+    # The drives (generated 2 at a time, cached by scenario content and generator build).
     generations = Jobs(args.jobs)
     for scenario in scenarios:
         if scenario == REAL:

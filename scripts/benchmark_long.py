@@ -73,7 +73,10 @@ def generate_drive(args, drive):
 
     before = stamp_time()
     wall, cpu = timed(lambda: benchmark.generate(args, scenario, drive))
-    if stamp_time() != before or not os.path.exists(timing_path):
+    generated = stamp_time() != before
+    print("[benchmark] %s: %s" % (SCENARIO, "generated (%.0f s)" % wall if generated
+                                  else "the cached drive"), file=sys.stderr)
+    if generated or not os.path.exists(timing_path):
         json.dump({"wall_s": wall, "cpu_s": cpu}, open(timing_path, "w"))
     timing = json.load(open(timing_path))
     return timing["wall_s"], timing["cpu_s"]
@@ -214,7 +217,8 @@ def main(args, out_root):
     require_stats_option(args)
     drive = os.path.join(out_root, "drives", SCENARIO)
     out = os.path.join(out_root, "maps", SCENARIO, "mapper")
-    print("[benchmark] %s: generating (cached)" % SCENARIO, file=sys.stderr)
+    print("[benchmark] %s: generating unless cached (the scenario and the generator's build)"
+          % SCENARIO, file=sys.stderr)
     gen_wall, gen_cpu = generate_drive(args, drive)
     print("[benchmark] %s: mapping (config/mapper.yaml)" % SCENARIO, file=sys.stderr)
     map_wall, map_cpu = map_drive(args, drive, out)
