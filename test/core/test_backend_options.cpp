@@ -4,9 +4,9 @@
 #include <gtest/gtest.h>
 #include <yaml-cpp/yaml.h>
 
-#include <functional>
 #include <string>
 
+#include "common/options_test_utils.h"
 #include "ipm_road_mapper/core/backend/backend_options.h"
 #include "ipm_road_mapper/core/io/yaml_options.h"
 
@@ -17,20 +17,6 @@ const std::string kMapperYaml = std::string(IRM_SOURCE_DIR) + "/config/mapper.ya
 
 BackendOptions LoadFrom(const std::string& yaml) {
   return LoadBackendOptions(OptionsReader(YAML::Load(yaml), "backend"));
-}
-
-// The message of the OptionsError thrown by `f` ("" and a test failure when none is thrown).
-std::string ErrorOf(const std::function<void()>& f) {
-  try {
-    f();
-  } catch (const OptionsError& e) {
-    return e.what();
-  } catch (const std::exception& e) {
-    ADD_FAILURE() << "expected OptionsError, got another exception: " << e.what();
-    return e.what();
-  }
-  ADD_FAILURE() << "expected OptionsError, nothing was thrown";
-  return "";
 }
 
 TEST(RobustKernel, ParsesEveryConfigStringAndRoundTrips) {
