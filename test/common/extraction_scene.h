@@ -15,6 +15,7 @@
 
 #include "common/class_values.h"
 #include "common/mask_test_utils.h"
+#include "common/units.h"
 #include "ipm_road_mapper/core/frontend/instance_extraction.h"
 
 namespace ipm_road_mapper {
@@ -27,7 +28,6 @@ using test::RenderGroundRectangle;
 using test::RenderLaneStrip;
 using test::TestIpm;
 
-constexpr double kDeg = M_PI / 180.0;
 // Mask values of config/classes.yaml classes: 1 lane_white_solid, 2 lane_white_dashed,
 // 10 arrow_straight, 21 stop_line; class 50 is not in the table.
 constexpr std::uint16_t kSolidLane = 1 * kInstanceIdFactor;

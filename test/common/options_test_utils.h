@@ -11,12 +11,12 @@
 #include <functional>
 #include <string>
 
+#include "common/units.h"
 #include "ipm_road_mapper/core/io/yaml_options.h"
 #include "ipm_road_mapper/core/mapper/mapper_options.h"
 
 namespace ipm_road_mapper {
 
-constexpr double kDeg = M_PI / 180.0;
 inline const std::string kConfigDir = std::string(IRM_SOURCE_DIR) + "/config";
 
 inline OptionsReader ReaderOf(const std::string& yaml) {

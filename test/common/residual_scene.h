@@ -17,13 +17,13 @@
 #include <vector>
 
 #include "common/test_scene.h"
+#include "common/units.h"
 #include "ipm_road_mapper/core/geometry/pinhole_camera.h"
 #include "ipm_road_mapper/core/geometry/rigid_transform.h"
 
 namespace ipm_road_mapper {
 namespace residuals {
 
-constexpr double kDeg = M_PI / 180.0;
 // Relative precision of the gradient checks. The residuals never run the distortion's
 // Newton inversion (only the forward model), so autodiff and Ridders' differences agree
 // far below this (worst observed: 7e-10 for the corner reprojection, 2e-12 for PPSR,

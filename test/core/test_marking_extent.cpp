@@ -4,16 +4,11 @@
 #include <Eigen/Geometry>
 #include <cmath>
 
+#include "common/marking_test_utils.h"
 #include "ipm_road_mapper/core/mapper/marking_extent.h"
 
 namespace ipm_road_mapper {
 namespace {
-
-// Rectangle [x0, x1] x [y0, y1], counter-clockwise from (x0, y0).
-std::array<Eigen::Vector3d, 4> Rect(double x0, double x1, double y0, double y1) {
-  return {Eigen::Vector3d(x0, y0, 0), Eigen::Vector3d(x1, y0, 0), Eigen::Vector3d(x1, y1, 0),
-          Eigen::Vector3d(x0, y1, 0)};
-}
 
 // An element 4 m along x and 10 m along y whose sides 0 and 2 (y = -5, y = +5) were
 // measured and whose sides 1 and 3 (x = 24, x = 20) were cut by the view.

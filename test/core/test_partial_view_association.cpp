@@ -2,17 +2,12 @@
 // measured sides, wherever along the cut directions its center lies.
 #include <gtest/gtest.h>
 
+#include "common/marking_test_utils.h"
 #include "ipm_road_mapper/core/frontend/association.h"
 #include "ipm_road_mapper/core/frontend/partial_view_association.h"
 
 namespace ipm_road_mapper {
 namespace {
-
-// Rectangle [x0, x1] x [y0, y1], counter-clockwise from (x0, y0).
-std::array<Eigen::Vector3d, 4> Rect(double x0, double x1, double y0, double y1) {
-  return {Eigen::Vector3d(x0, y0, 0), Eigen::Vector3d(x1, y0, 0), Eigen::Vector3d(x1, y1, 0),
-          Eigen::Vector3d(x0, y1, 0)};
-}
 
 // A 0.4 m x 14 m stop line across the road at x = 72, its near and far edges (sides 3, 1)
 // measured, its ends (sides 0, 2) never seen.
