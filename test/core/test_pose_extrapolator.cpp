@@ -57,7 +57,9 @@ TEST(PoseExtrapolator, TheNewestPoseFollowsTheSolvedMotionNotTheNewestJitter) {
     error_carried += (carried.translation() - d.truth.back().translation()).norm() / runs;
   }
   EXPECT_GT(error_carried, 0.07);  // the jitter (0.08 m per axis: ~0.1 m mean)
-  EXPECT_LT(error_extrapolated, 0.6 * error_carried)
+  // Measured 0.31x (0.029 vs 0.094 m); the tail under the map-frame motion prior, 20 frames,
+  // was held to 0.6x.
+  EXPECT_LT(error_extrapolated, 0.45 * error_carried)
       << error_extrapolated << " vs " << error_carried;
 }
 
@@ -79,16 +81,18 @@ TEST(PoseExtrapolator, TheSolvedFramesOwnErrorsDoNotSetTheVelocity) {
     error_extrapolated += (T.translation() - d.truth.back().translation()).norm() / runs;
     error_carried += (carried.translation() - d.truth.back().translation()).norm() / runs;
   }
-  EXPECT_LT(error_extrapolated, 0.6 * error_carried)
+  EXPECT_LT(error_extrapolated, 0.45 * error_carried)  // measured 0.32x
       << error_extrapolated << " vs " << error_carried;
 }
 
-// The motion prior pulls towards constant velocity: on a 200 m curve at 10 m/s (0.5 m/s^2)
-// the tail of 0.5 s bends away from exact odometry by about 5 cm (a known cost).
-TEST(PoseExtrapolator, WithoutJitterItStaysNearTheCarriedOdometry) {
+// A constant-speed turn costs the tail's constant-twist prior nothing: on a 200 m curve at
+// 10 m/s the newest pose is the exact one. The map-frame motion prior (motion_prior_residual.h)
+// took the centripetal 0.5 m/s^2 for an acceleration and bent it outwards by about 5 cm.
+TEST(PoseExtrapolator, WithoutJitterItFollowsTheCurveExactly) {
   const Drive d = MakeDrive(40, 0.0, 1);
   const Eigen::Isometry3d T = ExtrapolateNewestPose(d.frames, 30, d.T_map_odom, BackendOptions());
-  EXPECT_LT((T.translation() - d.truth.back().translation()).norm(), 0.06);
+  EXPECT_LT((T.translation() - d.truth.back().translation()).norm(), 1e-6);
+  EXPECT_TRUE(T.linear().isApprox(d.truth.back().linear(), 1e-9));
 }
 
 TEST(PoseExtrapolator, FallsBackToTheCarriedOdometry) {

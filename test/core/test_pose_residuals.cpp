@@ -1,6 +1,6 @@
 // Tests of the Ceres prior residuals of the pose optimization (docs/design.md §4): the
-// pose prior and the motion prior; autodiff Jacobians against numeric differences (on the
-// quaternion manifold) and values against independently computed formulas.
+// pose prior, the motion prior and the constant-twist prior; autodiff Jacobians against numeric
+// differences (on the quaternion manifold) and values against independently computed formulas.
 #include <ceres/ceres.h>
 #include <gtest/gtest.h>
 
@@ -9,6 +9,7 @@
 #include <vector>
 
 #include "common/residual_scene.h"
+#include "ipm_road_mapper/core/backend/residuals/constant_twist_prior_residual.h"
 #include "ipm_road_mapper/core/backend/residuals/motion_prior_residual.h"
 #include "ipm_road_mapper/core/backend/residuals/pose_prior_residual.h"
 
@@ -184,6 +185,89 @@ TEST_F(MotionPriorTest, IsTheChangeOfTurnRateOverSigma) {
 TEST_F(MotionPriorTest, GradientCheck) {
   std::unique_ptr<ceres::CostFunction> cost(
       MotionPriorResidual::Create(dt_a_, dt_b_, sigma_acc_, sigma_ang_));
+  const PoseBlocks p0 = ToBlocks(VehiclePose());
+  const PoseBlocks p1 = ToBlocks(
+      VehiclePose() * ExpSe3((Vector6d() << 0.5, 0.02, 0.01, 0.003, -0.002, 0.02).finished()));
+  const PoseBlocks p2 = ToBlocks(
+      VehiclePose() * ExpSe3((Vector6d() << 1.1, -0.03, 0.02, -0.004, 0.003, 0.05).finished()));
+  const std::vector<const ceres::Manifold*> manifolds = {
+      &kQuaternionManifold, nullptr, &kQuaternionManifold, nullptr, &kQuaternionManifold, nullptr};
+  ExpectJacobiansMatch(
+      *cost, manifolds,
+      {p0.q.data(), p0.t.data(), p1.q.data(), p1.t.data(), p2.q.data(), p2.t.data()},
+      kGradientPrecision);
+}
+
+// ---------------------------------------------------------------------------------------
+// Constant-twist prior (the newest poses' tail, pose_extrapolator.h).
+
+class ConstantTwistPriorTest : public ::testing::Test {
+ protected:
+  Eigen::VectorXd Residual(const std::array<PoseBlocks, 3>& p, double dt_a, double dt_b) const {
+    std::unique_ptr<ceres::CostFunction> cost(
+        ConstantTwistPriorResidual::Create(dt_a, dt_b, sigma_acc_, sigma_ang_));
+    return Evaluate(*cost, {p[0].q.data(), p[0].t.data(), p[1].q.data(), p[1].t.data(),
+                            p[2].q.data(), p[2].t.data()});
+  }
+  // Three poses on a circle of `radius` at `speed`, heading along it, `dt` apart, pitched a
+  // little, starting at heading `yaw0`.
+  static std::array<PoseBlocks, 3> OnArc(double radius, double speed, double dt, double yaw0) {
+    std::array<PoseBlocks, 3> p;
+    for (int i = 0; i < 3; ++i) {
+      const double yaw = yaw0 + speed * dt * i / radius;
+      Eigen::Isometry3d T = Eigen::Isometry3d::Identity();
+      T.linear() = RotationFromRpy(0.0, 1.5 * kDeg, yaw);
+      T.translation() = Eigen::Vector3d(radius * std::sin(yaw), -radius * std::cos(yaw), 0.3);
+      p[i] = ToBlocks(T);
+    }
+    return p;
+  }
+  const Eigen::Vector3d sigma_acc_ = Eigen::Vector3d(1.0, 2.0, 4.0);
+  const Eigen::Vector3d sigma_ang_ = Eigen::Vector3d(0.5, 0.25, 0.125);
+};
+
+TEST_F(ConstantTwistPriorTest, IsZeroOnAConstantSpeedTurnWhereTheMapFramePriorIsNot) {
+  // 10 m/s on a 200 m curve: the map-frame prior sees the centripetal 0.5 m/s^2.
+  const std::array<PoseBlocks, 3> p = OnArc(200.0, 10.0, 0.05, 0.7);
+  EXPECT_LT(Residual(p, 0.05, 0.05).norm(), 1e-9);
+  std::unique_ptr<ceres::CostFunction> map_frame(
+      MotionPriorResidual::Create(0.05, 0.05, sigma_acc_, sigma_ang_));
+  const Eigen::VectorXd r_map = Evaluate(*map_frame, {p[0].q.data(), p[0].t.data(), p[1].q.data(),
+                                                      p[1].t.data(), p[2].q.data(), p[2].t.data()});
+  EXPECT_NEAR(r_map.head<3>().norm(), 0.5 / sigma_acc_(1), 0.01);
+  std::array<PoseBlocks, 3> negated = p;
+  negated[2] = Negated(negated[2]);  // the quaternion sign means nothing
+  EXPECT_LT(Residual(negated, 0.05, 0.05).norm(), 1e-9);
+}
+
+TEST_F(ConstantTwistPriorTest, IsTheChangeOfSpeedInTheBodyFrameOverSigma) {
+  // Heading 90 deg in the map (body x is map y): 10 m/s, then 10.09 m/s.
+  const double dt_a = 0.05, dt_b = 0.04, dt = 0.5 * (dt_a + dt_b);
+  const double ys[3] = {0.0, 10.0 * dt_a, 10.0 * dt_a + 10.09 * dt_b};
+  std::array<PoseBlocks, 3> p;
+  for (int i = 0; i < 3; ++i) p[i] = ToBlocks(test::PlanarPose(3.0, ys[i], M_PI / 2));
+  const Eigen::VectorXd r = Residual(p, dt_a, dt_b);
+  EXPECT_NEAR(r(0), 0.09 / (dt * sigma_acc_(0)), 1e-9);
+  EXPECT_NEAR(r(1), 0.0, 1e-9);
+  EXPECT_NEAR(r(2), 0.0, 1e-9);
+  EXPECT_LT(r.tail<3>().norm(), 1e-9);
+}
+
+TEST_F(ConstantTwistPriorTest, IsTheChangeOfTurnRateOverSigma) {
+  const double dt_a = 0.05, dt_b = 0.06, dt = 0.5 * (dt_a + dt_b);
+  const double yaw[3] = {0.0, 0.1 * dt_a, 0.1 * dt_a + 0.2 * dt_b};
+  std::array<PoseBlocks, 3> p;
+  for (int i = 0; i < 3; ++i) p[i] = ToBlocks(test::PlanarPose(1.0, 2.0, yaw[i]));
+  const Eigen::VectorXd r = Residual(p, dt_a, dt_b);
+  EXPECT_LT(r.head<3>().norm(), 1e-9);
+  EXPECT_NEAR(r(5), 0.1 / (dt * sigma_ang_(2)), 1e-9);
+  EXPECT_NEAR(r(3), 0.0, 1e-9);
+  EXPECT_NEAR(r(4), 0.0, 1e-9);
+}
+
+TEST_F(ConstantTwistPriorTest, GradientCheck) {
+  std::unique_ptr<ceres::CostFunction> cost(
+      ConstantTwistPriorResidual::Create(0.05, 0.06, sigma_acc_, sigma_ang_));
   const PoseBlocks p0 = ToBlocks(VehiclePose());
   const PoseBlocks p1 = ToBlocks(
       VehiclePose() * ExpSe3((Vector6d() << 0.5, 0.02, 0.01, 0.003, -0.002, 0.02).finished()));
