@@ -26,7 +26,7 @@ import irm_rostest as irm  # noqa: E402
 FRAMES = 300  # 15 s at 20 Hz
 SCENARIO = os.path.join(irm.SOURCE_DIR, "config", "scenarios", "public_road.yaml")
 # The corrected poses' mean error at most this fraction of the input's. Measured
-# 0.568-0.575 (0.0855 -> 0.0486-0.0492 m over four runs) with the newest pose's tail under the
+# 0.566-0.575 (0.0855 -> 0.0484-0.0492 m over six runs) with the newest pose's tail under the
 # constant-twist prior (pose_extrapolator.h); 0.63-0.65 under the map-frame motion prior,
 # which bent the tail outwards on curves, and 0.76 with the two newest solved frames held as
 # the tail's data. What is left is the window's newest frames' own error (a causal estimate:
