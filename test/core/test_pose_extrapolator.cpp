@@ -95,28 +95,6 @@ TEST(PoseExtrapolator, WithoutJitterItFollowsTheCurveExactly) {
   EXPECT_TRUE(T.linear().isApprox(d.truth.back().linear(), 1e-9));
 }
 
-// The tail's covariance of the newest pose (what ~corrected_odom carries in place of the
-// newest message's own odometry noise): set when the tail is solved, symmetric, positive,
-// below one message's noise in x and y (the tail averages the jitter of its frames) and not
-// zero; left unset where the tail falls back to the carried odometry.
-TEST(PoseExtrapolator, TheNewestPosesCovarianceIsTheTailsOwn) {
-  const Drive d = MakeDrive(40, 0.08, 5);
-  const BackendOptions options;
-  PoseCovariance covariance = PoseCovariance::Zero();
-  bool set = false;
-  ExtrapolateNewestPose(d.frames, 30, d.T_map_odom, options, &covariance, &set);
-  ASSERT_TRUE(set);
-  EXPECT_TRUE(covariance.isApprox(covariance.transpose(), 1e-9));
-  EXPECT_GT(covariance.ldlt().vectorD().minCoeff(), 0.0);
-  const double sigma_x = options.pose_prior_sigma_trans_m.x();
-  for (int i = 0; i < 2; ++i) {
-    EXPECT_LT(covariance(i, i), 0.5 * sigma_x * sigma_x) << i;
-    EXPECT_GT(covariance(i, i), 0.01 * sigma_x * sigma_x) << i;
-  }
-  ExtrapolateNewestPose(d.frames, 0, d.T_map_odom, options, &covariance, &set);
-  EXPECT_FALSE(set);
-}
-
 TEST(PoseExtrapolator, FallsBackToTheCarriedOdometry) {
   const Drive d = MakeDrive(60, 0.08, 3);
   const Eigen::Isometry3d carried = d.T_map_odom * d.frames.back().T_map_base_odom;

@@ -111,17 +111,11 @@ std::optional<PoseEstimate> Mapper::NewestPose() const {
   PoseEstimate estimate;
   estimate.stamp = newest.stamp;
   const std::int64_t solved = store_.corrected_frame();
-  // The tail's covariance of the newest pose stands for the newest message's own odometry
-  // noise, which the tail averaged down (pose_extrapolator.h).
-  PoseCovariance tail_covariance;
-  bool tail_solved = false;
-  estimate.T_map_base =
-      solved >= 0 && static_cast<std::size_t>(solved) < newest.index
-          ? ExtrapolateNewestPose(frames, static_cast<std::size_t>(solved), store_.T_map_odom(),
-                                  options_.backend, &tail_covariance, &tail_solved)
-          : store_.CorrectedPose(newest.index);
-  estimate.covariance =
-      windows_.PoseCovarianceOf(newest.index, tail_solved ? &tail_covariance : nullptr);
+  estimate.T_map_base = solved >= 0 && static_cast<std::size_t>(solved) < newest.index
+                            ? ExtrapolateNewestPose(frames, static_cast<std::size_t>(solved),
+                                                    store_.T_map_odom(), options_.backend)
+                            : store_.CorrectedPose(newest.index);
+  estimate.covariance = windows_.PoseCovarianceOf(newest.index);
   estimate.T_map_odom = estimate.T_map_base * newest.T_map_base_odom.inverse();
   return estimate;
 }

@@ -35,9 +35,7 @@ struct Blocks {
 
 Eigen::Isometry3d ExtrapolateNewestPose(const std::vector<FrameRecord>& frames, std::size_t solved,
                                         const Eigen::Isometry3d& T_map_odom,
-                                        const BackendOptions& options, PoseCovariance* covariance,
-                                        bool* covariance_set) {
-  if (covariance_set) *covariance_set = false;
+                                        const BackendOptions& options) {
   const std::size_t newest = frames.size() - 1;
   const Eigen::Isometry3d carried = T_map_odom * frames[newest].T_map_base_odom;
   const std::size_t span = static_cast<std::size_t>(options.window_frames);
@@ -83,10 +81,6 @@ Eigen::Isometry3d ExtrapolateNewestPose(const std::vector<FrameRecord>& frames, 
   ceres::Solver::Summary summary;
   ceres::Solve(solver, &problem, &summary);
   if (!summary.IsSolutionUsable()) return carried;
-  if (covariance && covariance_set) {
-    *covariance_set = ComputePoseCovariance(&problem, poses.back().q.coeffs().data(),
-                                            poses.back().t.data(), covariance);
-  }
   return poses.back().ToIsometry();
 }
 

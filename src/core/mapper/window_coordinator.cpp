@@ -32,14 +32,11 @@ BackendStats WindowCoordinator::stats() const {
   return backend_ ? backend_->stats() : BackendStats();
 }
 
-PoseCovariance WindowCoordinator::PoseCovarianceOf(std::size_t index,
-                                                   const PoseCovariance* own_noise) const {
+PoseCovariance WindowCoordinator::PoseCovarianceOf(std::size_t index) const {
   const BackendOptions& o = options_.backend;
   const Eigen::Isometry3d T_map_base = store_->CorrectedPose(index);
   const PoseCovariance odometry =
-      own_noise ? *own_noise
-                : OdometryPoseCovariance(T_map_base, o.pose_prior_sigma_trans_m,
-                                         o.pose_prior_sigma_rot_rad);
+      OdometryPoseCovariance(T_map_base, o.pose_prior_sigma_trans_m, o.pose_prior_sigma_rot_rad);
   if (pose_covariance_frame_ < 0 || static_cast<std::size_t>(pose_covariance_frame_) > index)
     return odometry;
   const std::size_t solved = static_cast<std::size_t>(pose_covariance_frame_);

@@ -18,22 +18,15 @@
 #include <vector>
 
 #include "ipm_road_mapper/core/backend/backend_options.h"
-#include "ipm_road_mapper/core/backend/pose_covariance.h"
 #include "ipm_road_mapper/core/map/road_map.h"
 
 namespace ipm_road_mapper {
 
 // The pose of frames.back(), `solved` being the newest frame a solve moved and T_map_odom
 // its correction. T_map_odom * odometry when the tail cannot be solved (no motion prior, no
-// frame before `solved`, a tail longer than backend.window_frames, a failed solve). With
-// `covariance` given and the tail solved, *covariance is set to the newest pose's covariance
-// in the tail problem (ComputePoseCovariance: the odometry noise its frames average, in place
-// of the newest message's own) and true is stored in *covariance_set; else *covariance_set is
-// false.
+// frame before `solved`, a tail longer than backend.window_frames, a failed solve).
 Eigen::Isometry3d ExtrapolateNewestPose(const std::vector<FrameRecord>& frames, std::size_t solved,
                                         const Eigen::Isometry3d& T_map_odom,
-                                        const BackendOptions& options,
-                                        PoseCovariance* covariance = nullptr,
-                                        bool* covariance_set = nullptr);
+                                        const BackendOptions& options);
 
 }  // namespace ipm_road_mapper

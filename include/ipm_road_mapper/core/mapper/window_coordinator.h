@@ -62,10 +62,8 @@ class WindowCoordinator {
   // The covariance of frame `index`'s corrected pose (pose_covariance.h): the last solve's
   // covariance of its newest optimized frame carried along the odometry to it, plus the
   // frame's own odometry noise (backend.pose_prior_sigma_*) when no solve has reached it;
-  // that noise alone before the first solve or without a back end. `own_noise`, when given,
-  // replaces that odometry noise (the newest pose's tail covariance, pose_extrapolator.h).
-  PoseCovariance PoseCovarianceOf(std::size_t index,
-                                  const PoseCovariance* own_noise = nullptr) const;
+  // that noise alone before the first solve or without a back end.
+  PoseCovariance PoseCovarianceOf(std::size_t index) const;
   // The camera of the last used frame (the snapshots', and the export re-fit's).
   const CameraIntrinsics& camera() const { return camera_; }
 
