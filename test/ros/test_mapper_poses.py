@@ -26,7 +26,7 @@ import irm_rostest as irm  # noqa: E402
 FRAMES = 300  # 15 s at 20 Hz
 SCENARIO = os.path.join(irm.SOURCE_DIR, "config", "scenarios", "public_road.yaml")
 # The corrected poses' mean error at most this fraction of the input's. Measured
-# 0.566-0.575 (0.0855 -> 0.0484-0.0492 m over six runs) with the newest pose's tail under the
+# 0.564-0.579 (0.0855 -> 0.0482-0.0495 m over nine runs) with the newest pose's tail under the
 # constant-twist prior (pose_extrapolator.h); 0.63-0.65 under the map-frame motion prior,
 # which bent the tail outwards on curves, and 0.76 with the two newest solved frames held as
 # the tail's data. What is left is the window's newest frames' own error (a causal estimate:
@@ -34,11 +34,12 @@ SCENARIO = os.path.join(irm.SOURCE_DIR, "config", "scenarios", "public_road.yaml
 # made the poses worse (1.5x with the velocity taken from the odometry) fails here.
 MAX_ERROR_RATIO = 0.62
 # The published covariance against the error it describes: the mean squared x/y error over
-# the mean x/y variance of the messages after the first solve. Measured 0.23-0.29 (sigma
-# ~0.085 / 0.064 m against an rms error of ~0.04 m, the newest pose's tail covariance, not
-# the newest message's odometry noise); 0.05-0.06 when the full odometry noise (0.15 m) was
-# added. Above 1 the covariance would be overconfident.
-COVARIANCE_CONSISTENCY = (0.1, 1.0)
+# the mean x/y variance of the messages after the first solve must stay below 1 (not
+# overconfident). Measured 0.06: the newest frame's full odometry noise (0.15 m per axis) is
+# on top of the solve's carried marginal, against an rms error of ~0.04 m. The tail's own
+# covariance in its place (0.25 here) was overconfident on port (2.6: its slow drift is in
+# neither the solve's marginal nor the tail's white-noise model; docs/backend.md).
+MAX_COVARIANCE_CONSISTENCY = 1.0
 
 
 def distance(a, b):
@@ -123,9 +124,7 @@ class MapperPosesTest(unittest.TestCase):
 
     def test_corrected_odom_covariance_describes_its_error(self):
         self.assertGreaterEqual(len(self.variance_xy), 0.8 * FRAMES)
-        low, high = COVARIANCE_CONSISTENCY
-        self.assertGreaterEqual(self.consistency, low)
-        self.assertLessEqual(self.consistency, high)
+        self.assertLessEqual(self.consistency, MAX_COVARIANCE_CONSISTENCY)
 
     def test_corrected_odom_is_closer_to_the_truth_than_the_input(self):
         self.assertGreaterEqual(len(self.errors["corrected_odom"]), 0.9 * FRAMES)
