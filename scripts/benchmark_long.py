@@ -13,7 +13,7 @@ just past each km): the delta and changed markers built from the core's incremen
 as the nodelet does and beside them the old whole-map way (fingerprints of every element),
 and the core's export time: ExportChanges and the nodelet's snapshot (ExportSnapshot: what
 changed built, the rest shared), beside the snapshot as it was (ExportMap without the lane
-topology, every element copied). Figures are measured and printed; nothing
+topology, every element copied), and the publish's and ExportChanges' median per km. Figures are measured and printed; nothing
 is asserted.
 """
 import csv
@@ -175,6 +175,11 @@ def publish_rows(publish):
     def column(key):
         return " / ".join(fmt(median([r[key] for r in parts[km]]), 3) for km in kms)
 
+    def per_km(key):
+        every = sorted({int(r["km"]) for r in publish})
+        return " ".join(fmt(median([r[key] for r in publish if int(r["km"]) == km]), 3)
+                        for km in every)
+
     label = "/".join(str(km) for km in kms)
     counts = " / ".join(str(len(parts[km])) for km in kms)
     elements = " / ".join(fmt(median([r["markings"] + r["lanes"] for r in parts[km]]), 0)
@@ -185,7 +190,9 @@ def publish_rows(publish):
              "%s ms / %s ms (whole-copy snapshot %s ms)" % (
                  column("export_changes_ms"), column("export_snapshot_ms"),
                  column("export_snapshot_old_ms"))],
-            ["publishes measured / map elements at %s km" % label, "%s / %s" % (counts, elements)]]
+            ["publishes measured / map elements at %s km" % label, "%s / %s" % (counts, elements)],
+            ["publish / ExportChanges CPU, median per km (1, 2, ...)",
+             "%s ms / %s ms" % (per_km("publish_ms"), per_km("export_changes_ms"))]]
 
 
 def evaluate(args, map_path, gt_path, metrics_path):

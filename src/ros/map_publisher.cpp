@@ -3,6 +3,8 @@
 #include <nav_msgs/Path.h>
 #include <visualization_msgs/MarkerArray.h>
 
+#include <algorithm>
+
 #include "ipm_road_mapper/ros/msg_conversion.h"
 #include "ipm_road_mapper/ros/vector_map_conversion.h"
 
@@ -22,6 +24,13 @@ MapPublisher::MapPublisher(ros::NodeHandle& private_nh, int path_max_poses,
   markers_pub_ = private_nh.advertise<visualization_msgs::MarkerArray>(
       "markers", 1, on_connect, ros::SubscriberStatusCallback(), ros::VoidConstPtr(), true);
   path_pub_ = private_nh.advertise<nav_msgs::Path>("corrected_path", 1, true);
+}
+
+ChangesOptions MapPublisher::ChangesNeeded() {
+  ChangesOptions options;
+  options.lane_context_points = std::max(VectorMapDeltaBuilder().lane_context_points(),
+                                         MarkerBuilder().lane_context_points());
+  return options;
 }
 
 PublishCounts MapPublisher::Publish(const SharedVectorMap& map, const std::string& map_frame,

@@ -6,6 +6,7 @@
 #include <utility>
 
 #include "ipm_road_mapper/core/mapper/lane_topology.h"
+#include "ipm_road_mapper/ros/map_publisher.h"
 
 namespace ipm_road_mapper {
 namespace {
@@ -363,7 +364,8 @@ void MappingWorker::Export() {
       std::lock_guard<std::mutex> lock(published_mutex_);
       if (published_resets_ == generation_) since = published_revision_;
     }
-    exported_changes_ = std::make_shared<const MapChanges>(session_.mapper()->ExportChanges(since));
+    exported_changes_ = std::make_shared<const MapChanges>(
+        session_.mapper()->ExportChanges(since, MapPublisher::ChangesNeeded()));
   }
   exported_version_ = map_version_;
   status_dirty_ = false;

@@ -5,6 +5,8 @@
 #include <cstdint>
 #include <exception>
 #include <functional>
+#include <stdexcept>
+#include <string>
 #include <vector>
 
 #include "ipm_road_mapper/core/geometry/catmull_rom_spline.h"
@@ -87,15 +89,27 @@ int LaneChunkMarkerId(std::uint64_t lane_id, std::size_t chunk) {
   return static_cast<int>(((lane_id & 0x1fffffu) << 10) | (chunk & 0x3ffu));
 }
 
-std::vector<LaneChunk> LaneChunks(std::size_t control_points, std::size_t chunk_segments) {
+std::size_t LaneChunkCount(std::size_t control_points, std::size_t chunk_segments) {
   chunk_segments = std::max<std::size_t>(chunk_segments, 1);
-  if (control_points < 4) return {{0, 0, control_points, 0, control_points}};
+  if (control_points < 4) return 1;
+  return (control_points - 3 + chunk_segments - 1) / chunk_segments;
+}
+
+LaneChunk LaneChunkAt(std::size_t control_points, std::size_t chunk_segments, std::size_t index) {
+  chunk_segments = std::max<std::size_t>(chunk_segments, 1);
+  if (control_points < 4) return {0, 0, control_points, 0, control_points};
   const std::size_t segments = control_points - 3;
+  const std::size_t first = index * chunk_segments;
+  const std::size_t end = std::min(first + chunk_segments, segments);
+  const bool last = end == segments;
+  return {index, first, end + 3, first, last ? control_points : end};
+}
+
+std::vector<LaneChunk> LaneChunks(std::size_t control_points, std::size_t chunk_segments) {
   std::vector<LaneChunk> chunks;
-  for (std::size_t first = 0; first < segments; first += chunk_segments) {
-    const std::size_t end = std::min(first + chunk_segments, segments);
-    const bool last = end == segments;
-    chunks.push_back({chunks.size(), first, end + 3, first, last ? control_points : end});
+  const std::size_t count = LaneChunkCount(control_points, chunk_segments);
+  for (std::size_t i = 0; i < count; ++i) {
+    chunks.push_back(LaneChunkAt(control_points, chunk_segments, i));
   }
   return chunks;
 }
@@ -128,36 +142,55 @@ bool MarkerBuilder::Unchanged(std::size_t ns_a, std::size_t ns_b, int id, std::s
   return true;
 }
 
-void MarkerBuilder::AddLane(const MapLane& lane, const std::string& frame_id,
-                            const ros::Time& stamp, Mode mode,
-                            visualization_msgs::MarkerArray* out) {
+std::size_t MarkerBuilder::AddLane(const MapLane& lane, std::size_t first_changed,
+                                   std::size_t offset, const std::string& frame_id,
+                                   const ros::Time& stamp, Mode mode,
+                                   visualization_msgs::MarkerArray* out) {
   using visualization_msgs::Marker;
   const std::vector<Eigen::Vector3d>& cps = lane.control_points_map;
+  const std::size_t points = offset + cps.size();
   const std_msgs::ColorRGBA color = ClassColor(lane.class_id, lane.class_name);
-  const std::vector<LaneChunk> chunks = LaneChunks(cps.size(), lane_chunk_segments_);
+  const std::size_t count = LaneChunkCount(points, lane_chunk_segments_);
   std::size_t& drawn = lane_chunks_[lane.id];
-  drawn = std::max(drawn, chunks.size());
-  for (const LaneChunk& chunk : chunks) {
+  drawn = std::max(drawn, count);
+  // The first chunk whose curve (points [curve_first, curve_first + segments + 3)) reaches
+  // the first changed point; the earlier ones are as drawn.
+  const std::size_t first_chunk =
+      first_changed < 3 ? 0 : std::min((first_changed - 3) / lane_chunk_segments_, count);
+  if (first_chunk < count &&
+      LaneChunkAt(points, lane_chunk_segments_, first_chunk).curve_first < offset) {
+    throw std::invalid_argument("MarkerBuilder: lane " + std::to_string(lane.id) +
+                                " came without the points its first changed chunk needs");
+  }
+  for (std::size_t index = first_chunk; index < count; ++index) {
+    const LaneChunk chunk = LaneChunkAt(points, lane_chunk_segments_, index);
+    const std::size_t curve_first = chunk.curve_first - offset;
+    const std::size_t curve_last = chunk.curve_last - offset;
     const int id = LaneChunkMarkerId(lane.id, chunk.index);
-    const std::size_t fingerprint = GeometryFingerprint(lane, chunk.curve_first, chunk.curve_last);
+    const std::size_t fingerprint = GeometryFingerprint(lane, curve_first, curve_last);
+    work_.points_fingerprinted += curve_last - curve_first;
     if (Unchanged(kLaneNs, kControlPointNs, id, fingerprint, mode)) continue;
+    work_.points_drawn += curve_last - curve_first;
     Marker line = NewMarker(kNamespaces[kLaneNs], id, Marker::LINE_STRIP, frame_id, stamp);
     line.scale.x = 0.15;  // line width, m (a painted lane line)
     line.color = color;
     for (const Eigen::Vector3d& p :
-         CurveSamples(cps, chunk.curve_first, chunk.curve_last, lane_sample_spacing_m_)) {
+         CurveSamples(cps, curve_first, curve_last, lane_sample_spacing_m_)) {
       line.points.push_back(ToPointMsg(p));
     }
     if (line.points.size() >= 2) Add(kLaneNs, fingerprint, std::move(line), out);
-    Marker points =
+    Marker points_marker =
         NewMarker(kNamespaces[kControlPointNs], id, Marker::SPHERE_LIST, frame_id, stamp);
-    points.scale.x = points.scale.y = points.scale.z = 0.3;
-    points.color = Rgba(color.r * 0.6f, color.g * 0.6f, color.b * 0.6f + 0.4f);
+    points_marker.scale.x = points_marker.scale.y = points_marker.scale.z = 0.3;
+    points_marker.color = Rgba(color.r * 0.6f, color.g * 0.6f, color.b * 0.6f + 0.4f);
     for (std::size_t i = chunk.points_first; i < chunk.points_last; ++i) {
-      points.points.push_back(ToPointMsg(cps[i]));
+      points_marker.points.push_back(ToPointMsg(cps[i - offset]));
     }
-    if (!points.points.empty()) Add(kControlPointNs, fingerprint, std::move(points), out);
+    if (!points_marker.points.empty()) {
+      Add(kControlPointNs, fingerprint, std::move(points_marker), out);
+    }
   }
+  return first_chunk;
 }
 
 void MarkerBuilder::AddMarking(const MapMarking& marking, const std::string& frame_id,
@@ -199,8 +232,9 @@ visualization_msgs::MarkerArray MarkerBuilder::Build(const VectorMap& map,
                                                      const ros::Time& stamp, Mode mode) {
   visualization_msgs::MarkerArray out;
   ++generation_;
+  work_ = Work();
   lane_chunks_.clear();
-  for (const MapLane& lane : map.lanes) AddLane(lane, frame_id, stamp, mode, &out);
+  for (const MapLane& lane : map.lanes) AddLane(lane, 0, 0, frame_id, stamp, mode, &out);
   for (const MapMarking& marking : map.markings) AddMarking(marking, frame_id, stamp, mode, &out);
   // What this map no longer draws: deleted on screen and forgotten.
   std::vector<std::uint64_t> stale;
@@ -217,17 +251,24 @@ visualization_msgs::MarkerArray MarkerBuilder::Build(const MapChanges& changes,
   if (changes.complete) return Build(changes.map, frame_id, stamp, Mode::kChanges);
   visualization_msgs::MarkerArray out;
   ++generation_;
-  for (const MapLane& lane : changes.map.lanes) {
-    AddLane(lane, frame_id, stamp, Mode::kChanges, &out);
+  work_ = Work();
+  for (std::size_t i = 0; i < changes.map.lanes.size(); ++i) {
+    const MapLane& lane = changes.map.lanes[i];
+    // Without the core's ranges (a hand-made MapChanges): the whole lane.
+    const std::size_t offset = i < changes.lane_offsets.size() ? changes.lane_offsets[i] : 0;
+    const std::size_t first_chunk =
+        AddLane(lane, i < changes.lane_first_changed.size() ? changes.lane_first_changed[i] : 0,
+                offset, frame_id, stamp, Mode::kChanges, &out);
     // The chunks it drew before and does not draw now (it lost points, or a chunk's curve
-    // could not be drawn).
-    for (std::size_t chunk = 0; chunk < lane_chunks_[lane.id]; ++chunk) {
+    // could not be drawn), of those it looked at.
+    for (std::size_t chunk = first_chunk; chunk < lane_chunks_[lane.id]; ++chunk) {
       const int id = LaneChunkMarkerId(lane.id, chunk);
       for (const std::size_t ns : {kLaneNs, kControlPointNs}) {
         DeleteIfStale(Key(ns, id), frame_id, stamp, &out);
       }
     }
-    lane_chunks_[lane.id] = LaneChunks(lane.control_points_map.size(), lane_chunk_segments_).size();
+    lane_chunks_[lane.id] =
+        LaneChunkCount(offset + lane.control_points_map.size(), lane_chunk_segments_);
   }
   for (const MapMarking& marking : changes.map.markings) {
     AddMarking(marking, frame_id, stamp, Mode::kChanges, &out);

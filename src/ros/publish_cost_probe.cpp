@@ -2,6 +2,7 @@
 
 #include <time.h>
 
+#include <algorithm>
 #include <cmath>
 #include <stdexcept>
 
@@ -22,6 +23,8 @@ PublishCostProbe::PublishCostProbe(const std::string& path, double publish_rate_
       path_(path),
       period_s_(publish_rate_hz > 0.0 ? 1.0 / publish_rate_hz : 0.5),
       publishes_per_km_(publishes_per_km) {
+  changes_options_.lane_context_points =
+      std::max(deltas_.lane_context_points(), markers_.lane_context_points());
   if (!out_) throw std::runtime_error(path + ": cannot open for writing");
   out_ << kHeader << "\n";
 }
@@ -48,7 +51,7 @@ void PublishCostProbe::OnFrame(const Mapper& mapper, std::size_t frame, double s
     Measure(mapper, frame, stamp);
     return;
   }
-  const MapChanges changes = mapper.ExportChanges(revision_);
+  const MapChanges changes = mapper.ExportChanges(revision_, changes_options_);
   revision_ = changes.revision;
   const ros::Time t(stamp);
   deltas_.Build(changes, "map", t);
@@ -59,7 +62,7 @@ void PublishCostProbe::OnFrame(const Mapper& mapper, std::size_t frame, double s
 void PublishCostProbe::Measure(const Mapper& mapper, std::size_t frame, double stamp) {
   const ros::Time t(stamp);
   double start = ThreadCpuMs();
-  const MapChanges changes = mapper.ExportChanges(revision_);
+  const MapChanges changes = mapper.ExportChanges(revision_, changes_options_);
   const double export_changes_ms = ThreadCpuMs() - start;
   revision_ = changes.revision;
   start = ThreadCpuMs();

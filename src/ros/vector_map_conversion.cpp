@@ -46,6 +46,26 @@ ipm_road_mapper::LaneSpline ToLaneMsg(const MapLane& lane) {
   return l;
 }
 
+ipm_road_mapper::LaneSplinePatch ToLanePatchMsg(const MapLane& lane, std::size_t from) {
+  ipm_road_mapper::LaneSplinePatch patch;
+  patch.id = lane.id;
+  patch.class_id = lane.class_id;
+  patch.class_name = lane.class_name;
+  patch.style = lane.style.empty() ? "unknown" : lane.style;
+  patch.first_index = static_cast<std::uint32_t>(from);
+  const std::vector<Eigen::Vector3d>& cps = lane.control_points_map;
+  from = std::min(from, cps.size());
+  patch.control_points.reserve(cps.size() - from);
+  for (std::size_t i = from; i < cps.size(); ++i)
+    patch.control_points.push_back(ToPointMsg(cps[i]));
+  patch.observations = lane.observations;
+  patch.first_seen = SafeTime(lane.first_seen);
+  patch.last_seen = SafeTime(lane.last_seen);
+  patch.predecessors = lane.predecessors;
+  patch.successors = lane.successors;
+  return patch;
+}
+
 ipm_road_mapper::VectorMapMsg ToVectorMapMsg(const VectorMap& map, const std::string& frame_id,
                                              const ros::Time& stamp) {
   ipm_road_mapper::VectorMapMsg msg;

@@ -2,6 +2,8 @@
 
 #include <algorithm>
 #include <functional>
+#include <stdexcept>
+#include <string>
 #include <unordered_set>
 #include <utility>
 
@@ -30,37 +32,10 @@ std::vector<std::uint64_t> EraseUnseen(std::unordered_map<std::uint64_t, Sent>* 
   return gone;
 }
 
-// A patch of `lane` carrying its control points from `first` on.
-ipm_road_mapper::LaneSplinePatch Patch(const MapLane& lane, std::size_t first) {
-  const ipm_road_mapper::LaneSpline whole = ToLaneMsg(lane);
-  ipm_road_mapper::LaneSplinePatch patch;
-  patch.id = whole.id;
-  patch.class_id = whole.class_id;
-  patch.class_name = whole.class_name;
-  patch.style = whole.style;
-  patch.first_index = static_cast<std::uint32_t>(first);
-  patch.control_points.assign(whole.control_points.begin() + first, whole.control_points.end());
-  patch.observations = whole.observations;
-  patch.first_seen = whole.first_seen;
-  patch.last_seen = whole.last_seen;
-  patch.predecessors = whole.predecessors;
-  patch.successors = whole.successors;
-  return patch;
-}
-
 }  // namespace
 
 VectorMapDeltaBuilder::VectorMapDeltaBuilder(std::size_t lane_chunk_points)
     : lane_chunk_points_(std::max<std::size_t>(lane_chunk_points, 1)) {}
-
-void VectorMapDeltaBuilder::Describe(const MapLane& lane, LaneSent* sent) const {
-  sent->fields = FieldsFingerprint(lane);
-  sent->points = lane.control_points_map.size();
-  sent->chunks.clear();
-  for (std::size_t first = 0; first < sent->points; first += lane_chunk_points_) {
-    sent->chunks.push_back(GeometryFingerprint(lane, first, first + lane_chunk_points_));
-  }
-}
 
 ipm_road_mapper::VectorMapDelta VectorMapDeltaBuilder::NewDelta(const std::string& frame_id,
                                                                 const ros::Time& stamp) {
@@ -82,26 +57,44 @@ void VectorMapDeltaBuilder::AddMarking(const MapMarking& marking,
   it->second = {fingerprint, generation_};
 }
 
-void VectorMapDeltaBuilder::AddLane(const MapLane& lane, LaneSent* now,
-                                    ipm_road_mapper::VectorMapDelta* delta) {
-  Describe(lane, now);
-  now->generation = generation_;
+void VectorMapDeltaBuilder::AddLane(const MapLane& lane, std::size_t first_changed,
+                                    std::size_t offset, ipm_road_mapper::VectorMapDelta* delta) {
+  const std::size_t points = offset + lane.control_points_map.size();
+  const std::size_t chunks = (points + lane_chunk_points_ - 1) / lane_chunk_points_;
   const auto [it, added] = lanes_.try_emplace(lane.id);
-  if (added) {
-    delta->lanes.push_back(Patch(lane, 0));
-  } else {
-    // The first chunk that differs: the points before it are as sent.
-    const LaneSent& before = it->second;
-    std::size_t chunk = 0;
-    while (chunk < now->chunks.size() && chunk < before.chunks.size() &&
-           now->chunks[chunk] == before.chunks[chunk]) {
-      ++chunk;
-    }
-    const std::size_t first = std::min(chunk * lane_chunk_points_, now->points);
-    const bool points_changed = first < now->points || now->points != before.points;
-    if (points_changed || now->fields != before.fields) delta->lanes.push_back(Patch(lane, first));
+  LaneSent& sent = it->second;
+  // The chunks before the one the first changed point falls in are as sent.
+  const std::size_t kept =
+      added ? 0 : std::min({first_changed / lane_chunk_points_, sent.chunks.size(), chunks});
+  if (kept * lane_chunk_points_ < offset) {
+    throw std::invalid_argument("VectorMapDeltaBuilder: lane " + std::to_string(lane.id) +
+                                " came without the points its first changed chunk needs");
   }
-  std::swap(it->second, *now);  // `now` keeps the old chunk vector's memory for the next lane
+  // The first chunk that differs from what was sent: the points before it are as sent.
+  std::size_t first = added ? 0 : points;
+  for (std::size_t chunk = kept; chunk < chunks; ++chunk) {
+    const std::size_t begin = chunk * lane_chunk_points_;
+    const std::size_t end = std::min(begin + lane_chunk_points_, points);
+    const std::size_t fingerprint = GeometryFingerprint(lane, begin - offset, end - offset);
+    work_.points_fingerprinted += end - begin;
+    if (chunk >= sent.chunks.size()) {
+      sent.chunks.push_back(fingerprint);
+      first = std::min(first, begin);
+    } else if (sent.chunks[chunk] != fingerprint) {
+      sent.chunks[chunk] = fingerprint;
+      first = std::min(first, begin);
+    }
+  }
+  sent.chunks.resize(chunks);
+  const std::size_t fields = FieldsFingerprint(lane);
+  if (first < points || points != sent.points || fields != sent.fields || added) {
+    delta->lanes.push_back(ToLanePatchMsg(lane, first - offset));
+    delta->lanes.back().first_index = static_cast<std::uint32_t>(first);
+    work_.points_converted += points - first;
+  }
+  sent.fields = fields;
+  sent.points = points;
+  sent.generation = generation_;
 }
 
 ipm_road_mapper::VectorMapDelta VectorMapDeltaBuilder::Build(const VectorMap& map,
@@ -109,9 +102,9 @@ ipm_road_mapper::VectorMapDelta VectorMapDeltaBuilder::Build(const VectorMap& ma
                                                              const ros::Time& stamp) {
   ipm_road_mapper::VectorMapDelta delta = NewDelta(frame_id, stamp);
   ++generation_;
+  work_ = Work();
   for (const MapMarking& marking : map.markings) AddMarking(marking, &delta);
-  LaneSent now;
-  for (const MapLane& lane : map.lanes) AddLane(lane, &now, &delta);
+  for (const MapLane& lane : map.lanes) AddLane(lane, 0, 0, &delta);
   delta.removed_marking_ids = EraseUnseen(&markings_, generation_);
   delta.removed_lane_ids = EraseUnseen(&lanes_, generation_);
   delta.base_to_camera = IsometryToTransform(map.T_base_cam);
@@ -124,9 +117,15 @@ ipm_road_mapper::VectorMapDelta VectorMapDeltaBuilder::Build(const MapChanges& c
   if (changes.complete) return Build(changes.map, frame_id, stamp);
   ipm_road_mapper::VectorMapDelta delta = NewDelta(frame_id, stamp);
   ++generation_;
+  work_ = Work();
   for (const MapMarking& marking : changes.map.markings) AddMarking(marking, &delta);
-  LaneSent now;
-  for (const MapLane& lane : changes.map.lanes) AddLane(lane, &now, &delta);
+  for (std::size_t i = 0; i < changes.map.lanes.size(); ++i) {
+    // Without the core's ranges (a hand-made MapChanges): the whole lane.
+    const std::size_t first_changed =
+        i < changes.lane_first_changed.size() ? changes.lane_first_changed[i] : 0;
+    const std::size_t offset = i < changes.lane_offsets.size() ? changes.lane_offsets[i] : 0;
+    AddLane(changes.map.lanes[i], first_changed, offset, &delta);
+  }
   // What left the map, of what was sent (the ids come sorted).
   for (std::uint64_t id : changes.removed_marking_ids) {
     if (markings_.erase(id)) delta.removed_marking_ids.push_back(id);

@@ -124,5 +124,73 @@ TEST(IncrementalPublication, EqualsThePublicationBuiltFromTheWholeMap) {
               created.size(), updated, removed, lane_patches, deletes);
 }
 
+// Frame k of a 400 m drive at 2 m a frame: the script's dashed lane and an arrow every 50 m
+// (missed now and then), the odometry 1.2 m ahead from frame 120 on (duplicates).
+FrameInput LongFrame(int k) {
+  const double x_vehicle = 2.0 * k;
+  FrameInput in;
+  in.stamp = 100.0 + 0.1 * k;
+  in.camera = TestCamera();
+  const Eigen::Isometry3d T_map_base = PoseAt(x_vehicle);
+  in.T_map_base_odom = PoseAt(x_vehicle + (k >= 120 ? 1.2 : 0.0));
+  in.mask = cv::Mat::zeros(720, 1280, CV_16UC1);
+  for (double x = 0.0; x < 440.0; x += 6.0) {
+    if (x < x_vehicle + 4.0 || x > x_vehicle + 35.0) continue;
+    FillGround(Rect(x, x + 3.0, 1.725, 1.875), T_map_base, 2001, &in.mask);
+  }
+  int instance = 1;
+  for (double x0 = 20.0; x0 < 420.0; x0 += 50.0, ++instance) {
+    if (x_vehicle + 6.0 < x0 && x0 < x_vehicle + 28.0 && k % 9 != 4) {
+      FillGround(Rect(x0, x0 + 3.0, -0.3, 0.3), T_map_base, 10000 + instance, &in.mask);
+    }
+  }
+  return in;
+}
+
+// A drive published as the nodelet does: the core's changes carry each changed lane's tail
+// only (with the context the builders ask for), and the builders look at the chunks from the
+// first changed point on; every message is still the whole-map way's. Returns how many lanes
+// came as tails.
+std::size_t ExpectTailsPublishAsTheWholeMap(FrameInput (*frame)(int), int frames,
+                                            std::size_t chunk) {
+  MapperOptions options;
+  options.backend.synchronous = true;
+  options.lanes.join.enabled = true;
+  Mapper mapper(options, TestClasses(), TestExtrinsic());
+  VectorMapDeltaBuilder old_deltas(chunk), new_deltas(chunk);
+  MarkerBuilder old_markers(0.5, chunk), new_markers(0.5, chunk);
+  ChangesOptions tails;
+  tails.lane_context_points =
+      std::max(new_deltas.lane_context_points(), new_markers.lane_context_points());
+  std::uint64_t revision = 0;
+  std::size_t ranged = 0;
+  const ros::Time stamp(1.0);
+  auto publish = [&](int k) {
+    SCOPED_TRACE("frame " + std::to_string(k));
+    const VectorMap map = mapper.ExportMap();
+    const MapChanges changes = mapper.ExportChanges(revision, tails);
+    revision = changes.revision;
+    for (std::size_t offset : changes.lane_offsets) ranged += offset > 0;
+    EXPECT_EQ(Bytes(new_deltas.Build(changes, "map", stamp)),
+              Bytes(old_deltas.Build(map, "map", stamp)));
+    EXPECT_EQ(MarkerSet(new_markers.Build(changes, "map", stamp)),
+              MarkerSet(old_markers.Build(map, "map", stamp, MarkerBuilder::Mode::kChanges)));
+  };
+  for (int k = 0; k < frames; ++k) {
+    mapper.ProcessFrame(frame(k));
+    publish(k);
+  }
+  mapper.Finish();
+  publish(-1);
+  return ranged;
+}
+
+TEST(IncrementalPublication, LaneTailsGiveThePublicationBuiltFromTheWholeMap) {
+  // The script (its lanes mostly within a window's reach, with short chunks), then the long
+  // drive with the nodelet's chunks: there most changes come as tails.
+  ExpectTailsPublishAsTheWholeMap(ScriptFrame, 150, 4);
+  EXPECT_GT(ExpectTailsPublishAsTheWholeMap(LongFrame, 200, 16), 50u);
+}
+
 }  // namespace
 }  // namespace ipm_road_mapper

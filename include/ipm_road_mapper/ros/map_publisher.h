@@ -57,6 +57,11 @@ class MapPublisher {
                         const ros::Time& stamp, bool map_changed = true,
                         const MapChanges* changes = nullptr);
 
+  // What the `changes` given to Publish must carry: each changed lane's tail with the
+  // context its builders' chunks need (the whole lane is not needed; the mapping thread
+  // exports these, MappingWorker).
+  static ChangesOptions ChangesNeeded();
+
   // True when the next Publish sends the full marker set (a new ~markers subscriber, or
   // the period elapsed).
   bool full_markers_due() const;

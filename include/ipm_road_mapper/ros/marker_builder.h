@@ -11,7 +11,9 @@
 // in kChanges mode an element whose fingerprint did not change is not built nor sent again
 // (the per-publish cost then follows what changed, not the map's length): a lane that grows
 // at its end re-sends its last chunk or two, not the whole lane. Built from the core's
-// incremental export (MapChanges), it looks at the changed and removed elements only. The
+// incremental export (MapChanges), it looks at the changed and removed elements only, and of
+// a changed lane at the chunks whose curve uses its first changed control point or a later
+// one (the core's changes may carry the lane's tail only). The
 // markers are those of kChanges on the whole map (the DELETEs may come in another order).
 // Marking marker ids are
 // the element ids (mod 2^31); lane chunk ids are LaneChunkMarkerId; both stable over the
@@ -53,6 +55,9 @@ struct LaneChunk {
 // How a lane of `control_points` points is cut into chunks of `chunk_segments` segments
 // (the last may be shorter; one chunk of every point when there is no spline, < 4 points).
 std::vector<LaneChunk> LaneChunks(std::size_t control_points, std::size_t chunk_segments);
+// How many chunks LaneChunks gives, and its chunk `index` (< that count), without the others.
+std::size_t LaneChunkCount(std::size_t control_points, std::size_t chunk_segments);
+LaneChunk LaneChunkAt(std::size_t control_points, std::size_t chunk_segments, std::size_t index);
 
 // Builds MarkerArrays of successive maps, with DELETEs for what disappeared.
 class MarkerBuilder {
@@ -80,15 +85,33 @@ class MarkerBuilder {
   // One DELETEALL marker (after ~reset); forgets what was published.
   visualization_msgs::MarkerArray Clear();
 
+  // The control points a changed lane's tail must carry before its first changed one
+  // (ChangesOptions::lane_context_points): the curve of the first chunk that uses it starts
+  // up to a chunk and 3 points before it. Build throws std::invalid_argument on a tail that
+  // starts later.
+  std::size_t lane_context_points() const { return lane_chunk_segments_ + 2; }
+
+  // What the last Build looked at: lane control points fingerprinted, and those of the lane
+  // chunks it drew (their cost; a lane that changed at its end costs about its last chunks).
+  struct Work {
+    std::size_t points_fingerprinted = 0;
+    std::size_t points_drawn = 0;
+  };
+  const Work& last_work() const { return work_; }
+
  private:
   // What was sent of one marker: its element's fingerprint, and the last Build that drew it.
   struct Sent {
     std::size_t fingerprint = 0;
     std::uint64_t generation = 0;
   };
-  // Adds the markers of `lane` (of `marking`) that are not unchanged in kChanges mode.
-  void AddLane(const MapLane& lane, const std::string& frame_id, const ros::Time& stamp, Mode mode,
-               visualization_msgs::MarkerArray* out);
+  // Adds the markers of `lane` (of `marking`) that are not unchanged in kChanges mode. `lane`
+  // holds the whole lane's points from `offset` on, and the chunks whose curve ends at or
+  // before `first_changed` are as drawn (0, 0: a whole lane, every chunk looked at). Returns
+  // the first chunk it looked at.
+  std::size_t AddLane(const MapLane& lane, std::size_t first_changed, std::size_t offset,
+                      const std::string& frame_id, const ros::Time& stamp, Mode mode,
+                      visualization_msgs::MarkerArray* out);
   void AddMarking(const MapMarking& marking, const std::string& frame_id, const ros::Time& stamp,
                   Mode mode, visualization_msgs::MarkerArray* out);
   // Records `marker` as published now with `fingerprint` and appends it to *out.
@@ -108,6 +131,7 @@ class MarkerBuilder {
   std::uint64_t generation_ = 0;  // Build calls so far
   // Chunks drawn of each lane (the incremental build deletes the ones a lane lost).
   std::unordered_map<std::uint64_t, std::size_t> lane_chunks_;
+  Work work_;
 };
 
 }  // namespace ipm_road_mapper

@@ -1,9 +1,9 @@
 // The map publication's cost per publish, measured in process along a drive (map_from_bag
 // --publish-stats-out, the long benchmark): at the nodelet's publish rate (in bag time) it
 // builds ~vector_map_delta and the changed ~markers as MapPublisher does, from the core's
-// incremental export (Mapper::ExportChanges), and, for comparison, the old way from the
-// whole exported map (fingerprints of every element), and the nodelet's snapshot export
-// (Mapper::ExportSnapshot, through a SnapshotCache kept along the drive as the nodelet's
+// incremental export (Mapper::ExportChanges, changed lanes as tails), and, for comparison, the old
+// way from the whole exported map (fingerprints of every element), and the nodelet's snapshot
+// export (Mapper::ExportSnapshot, through a SnapshotCache kept along the drive as the nodelet's
 // mapping thread keeps it) beside the snapshot export before it (ExportMap without the lane
 // topology, every element copied). Thread CPU of each step goes to a CSV row
 // (flushed: a run stopped early keeps its rows). ExportMap with the topology (what the
@@ -58,7 +58,8 @@ class PublishCostProbe {
   std::uint64_t revision_ = 0;
   VectorMapDeltaBuilder deltas_, old_deltas_;
   MarkerBuilder markers_, old_markers_;
-  SnapshotCache snapshots_;  // as the nodelet's mapping thread keeps it
+  SnapshotCache snapshots_;         // as the nodelet's mapping thread keeps it
+  ChangesOptions changes_options_;  // lane tails, as the nodelet's publisher asks for them
 };
 
 }  // namespace ipm_road_mapper

@@ -8,6 +8,7 @@
 #include <string>
 #include <vector>
 
+#include "ipm_road_mapper/LaneSplinePatch.h"
 #include "ipm_road_mapper/core/geometry/rigid_transform.h"
 #include "ipm_road_mapper/core/map/vector_map.h"
 #include "ipm_road_mapper/ros/vector_map_msg.h"
@@ -17,6 +18,10 @@ namespace ipm_road_mapper {
 // One marking / lane as its message (element stamps in seconds -> ros::Time).
 ipm_road_mapper::MarkingPolygon ToMarkingMsg(const MapMarking& marking);
 ipm_road_mapper::LaneSpline ToLaneMsg(const MapLane& lane);
+// `lane` as a ~vector_map_delta patch carrying control_points_map[from..] (first_index
+// `from`; a caller holding a lane's tail sets the index in the whole lane): ToLaneMsg's
+// fields, only the points from `from` converted.
+ipm_road_mapper::LaneSplinePatch ToLanePatchMsg(const MapLane& lane, std::size_t from);
 
 // VectorMap -> message in `frame_id` at `stamp`: markings (4 corners), lanes (control points,
 // phantom ends included), the refined extrinsic. Element stamps in seconds -> ros::Time.

@@ -4,8 +4,11 @@
 // fingerprint per marking and per chunk of each lane's control points, so a message
 // carries what changed, not the whole map: retired markings, which no solve moves any
 // more, are sent once; a lane that grows sends its last chunk or two. Built from the core's
-// incremental export (MapChanges), it looks at the changed elements only: its cost follows
-// what changed, not the map's length; the message is the one Build(VectorMap) would make.
+// incremental export (MapChanges), it looks at the changed elements only, and of a changed
+// lane at its chunks from the one its first changed control point falls in (the earlier
+// ones are kept as sent; the core's changes may carry the lane's tail only): its cost
+// follows what changed, not the map's length; the message is the one Build(VectorMap)
+// would make.
 #pragma once
 
 #include <ros/time.h>
@@ -41,6 +44,19 @@ class VectorMapDeltaBuilder {
   // A delta with `reset` set and nothing else (after ~reset); forgets every element.
   ipm_road_mapper::VectorMapDelta Clear(const std::string& frame_id, const ros::Time& stamp);
 
+  // The control points a changed lane's tail must carry before its first changed one
+  // (ChangesOptions::lane_context_points): the start of that point's chunk. Build throws
+  // std::invalid_argument on a tail that starts later, or on a tail of a lane it never sent.
+  std::size_t lane_context_points() const { return lane_chunk_points_ - 1; }
+
+  // What the last Build looked at: lane control points fingerprinted and converted into
+  // patches (their cost; a lane that changed at its end costs about its last chunks).
+  struct Work {
+    std::size_t points_fingerprinted = 0;
+    std::size_t points_converted = 0;
+  };
+  const Work& last_work() const { return work_; }
+
  private:
   // What was sent of one marking, and the last Build whose map held it.
   struct MarkingSent {
@@ -54,13 +70,13 @@ class VectorMapDeltaBuilder {
     std::size_t points = 0;
     std::uint64_t generation = 0;
   };
-  // Fills *sent with what `lane`'s patch would depend on (generation untouched).
-  void Describe(const MapLane& lane, LaneSent* sent) const;
   // Adds `marking` to `delta` when new or changed, and remembers it as of this generation.
   void AddMarking(const MapMarking& marking, ipm_road_mapper::VectorMapDelta* delta);
-  // Adds `lane`'s patch from its first changed chunk, when new or changed; `scratch` keeps
-  // its vector's memory from lane to lane.
-  void AddLane(const MapLane& lane, LaneSent* scratch, ipm_road_mapper::VectorMapDelta* delta);
+  // Adds `lane`'s patch from its first changed chunk, when new or changed, and remembers it.
+  // `lane` holds the whole lane's points from `offset` on; the whole lane's points before
+  // `first_changed` are as sent (0, 0: a whole lane, every chunk compared).
+  void AddLane(const MapLane& lane, std::size_t first_changed, std::size_t offset,
+               ipm_road_mapper::VectorMapDelta* delta);
   ipm_road_mapper::VectorMapDelta NewDelta(const std::string& frame_id, const ros::Time& stamp);
 
   std::size_t lane_chunk_points_;
@@ -68,6 +84,7 @@ class VectorMapDeltaBuilder {
   std::uint64_t generation_ = 0;  // Build calls so far
   std::unordered_map<std::uint64_t, MarkingSent> markings_;
   std::unordered_map<std::uint64_t, LaneSent> lanes_;
+  Work work_;
 };
 
 // Applies `delta` to `map` (a client's copy, started from a ~vector_map): what a subscriber

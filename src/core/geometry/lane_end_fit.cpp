@@ -233,7 +233,8 @@ std::vector<Eigen::Vector3d> FitLaneEnds(const std::vector<Eigen::Vector3d>& con
 
 void FitLaneEndsNear(const LaneEndFitOptions& options, const std::vector<Eigen::Vector3d>& points,
                      const std::vector<Eigen::Vector3d>& extension_points,
-                     std::vector<Eigen::Vector3d>* cps, int* added_at_start) {
+                     std::vector<Eigen::Vector3d>* cps, int* added_at_start,
+                     std::size_t* first_changed) {
   std::vector<Eigen::Vector3d> near = points;
   near.insert(near.end(), extension_points.begin(), extension_points.end());
   near.erase(std::remove_if(near.begin(), near.end(),
@@ -257,9 +258,11 @@ void FitLaneEndsNear(const LaneEndFitOptions& options, const std::vector<Eigen::
       (ends_inside && (fitted.size() != slice.size() + static_cast<std::size_t>(added) ||
                        fitted.back() != slice.back()))) {
     *cps = FitLaneEnds(*cps, points, options, added_at_start, &extension_points);
+    if (first_changed) *first_changed = 0;
     return;
   }
   *added_at_start = added;
+  if (first_changed) *first_changed = first;  // nothing before the slice moved
   const std::size_t old_size = slice.size();
   if (fitted.size() == old_size) {
     std::copy(fitted.begin(), fitted.end(), cps->begin() + first);

@@ -103,8 +103,7 @@ void LaneTracker::Update(const std::vector<LaneObservation>& observations,
     lane.history.push_back(std::move(measurements[c]));
     lane.last_frame = frame.index;
     lane.last_seen = frame.stamp;
-    Grow(&lane, frame.index, usable_map);
-    store_->Touch(&lane);
+    store_->Touch(&lane, Grow(&lane, frame.index, usable_map));
   }
   if (store_->frames().size() % static_cast<std::size_t>(options_.lanes.merge_every_n_frames) ==
       0) {
@@ -112,8 +111,8 @@ void LaneTracker::Update(const std::vector<LaneObservation>& observations,
   }
 }
 
-void LaneTracker::Grow(LaneElement* lane, std::size_t frame_index,
-                       const std::vector<Eigen::Vector3d>& usable_map) const {
+std::size_t LaneTracker::Grow(LaneElement* lane, std::size_t frame_index,
+                              const std::vector<Eigen::Vector3d>& usable_map) const {
   const std::size_t horizon = static_cast<std::size_t>(options_.lanes.end_fit_frames);
   std::vector<Eigen::Vector3d> points;
   for (auto m = lane->history.rbegin(); m != lane->history.rend(); ++m) {
@@ -121,9 +120,11 @@ void LaneTracker::Grow(LaneElement* lane, std::size_t frame_index,
     points.insert(points.end(), m->selected_map.begin(), m->selected_map.end());
   }
   int added_at_start = 0;
+  std::size_t first_changed = 0;
   FitLaneEndsNear(options_.lanes.end_fit, points, usable_map, &lane->control_points_map,
-                  &added_at_start);
+                  &added_at_start, &first_changed);
   lane->first_cp_index -= added_at_start;  // keeps older back-end results applicable
+  return first_changed;
 }
 
 void LaneTracker::Start(int class_id, const LaneMeasurement& measurement,
@@ -230,10 +231,12 @@ void LaneTracker::MergeLines() {
         points.insert(points.end(), m.selected_map.begin(), m.selected_map.end());
       }
       int added_at_start = 0;
-      first.control_points_map =
+      auto fitted =
           FitLaneEnds(first.control_points_map, points, options_.lanes.end_fit, &added_at_start);
+      const std::size_t changed_from = FirstChangedControlPoint(first.control_points_map, fitted);
+      first.control_points_map = std::move(fitted);
       first.first_cp_index -= added_at_start;
-      store_->Touch(&first);
+      store_->Touch(&first, added_at_start > 0 ? 0 : changed_from);
       lanes.erase(lanes.begin() + b);
       ++counters_->lanes_merged;
     }
@@ -281,8 +284,10 @@ void LaneTracker::JoinFragments(std::size_t settled_before_frame) {
     auto result = JoinLanes(lanes[best_a], lanes[best_b], join, options_.association,
                             options_.lanes.fit.chord_spacing_m);
     if (!result) return;  // degenerate: left apart (rare; the next merge tries again)
+    const auto changed_from =
+        FirstChangedControlPoint(lanes[best_a].control_points_map, result->control_points_map);
     lanes[best_a] = std::move(*result);
-    store_->Touch(&lanes[best_a]);
+    store_->Touch(&lanes[best_a], changed_from);
     lanes.erase(lanes.begin() + best_b);
     ++counters_->lanes_joined;
   }

@@ -172,7 +172,11 @@ void MapStore::Touch(MarkingElement* marking) {
   if (IsRetired(marking)) changes_.NoteRetired(marking->revision, marking->id);
 }
 
-void MapStore::Touch(LaneElement* lane) { lane->revision = changes_.Next(); }
+void MapStore::Touch(LaneElement* lane, std::size_t first_changed) {
+  lane->revision = changes_.Next();
+  if (!lane->exported_at && lane->Exported()) lane->exported_at = lane->revision;
+  changes_.NoteLane(lane->revision, lane->id, first_changed);
+}
 
 std::int64_t MapStore::RetiredIndexOf(std::uint64_t id) const {
   const auto it = retired_index_by_id_.find(id);

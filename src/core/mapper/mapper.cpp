@@ -1,5 +1,6 @@
 #include "ipm_road_mapper/core/mapper/mapper.h"
 
+#include <algorithm>
 #include <chrono>
 #include <cmath>
 #include <sstream>
@@ -169,8 +170,8 @@ bool Mapper::ExportMarking(const MarkingElement& element, MapMarking* marking) c
   return true;
 }
 
-bool Mapper::ExportLane(const LaneElement& element, MapLane* lane) const {
-  if (element.Observations() < 2) return false;
+bool Mapper::ExportLane(const LaneElement& element, MapLane* lane, std::size_t from) const {
+  if (!element.Exported()) return false;
   lane->id = element.id;
   lane->class_id = element.class_id;
   lane->class_name = ClassName(element.class_id);
@@ -178,10 +179,16 @@ bool Mapper::ExportLane(const LaneElement& element, MapLane* lane) const {
   lane->style = info ? ToString(info->style) : "unknown";
   // Lanes no lane residual refines are re-fit to all their points, re-IPMed with the final
   // extrinsic and poses (PGO-IPM: lanes follow the refined extrinsic).
-  lane->control_points_map =
-      !windows_.LanesRefined()
-          ? lanes_.RefitControlPoints(element, windows_.camera(), windows_.T_base_cam())
-          : element.control_points_map;
+  if (!windows_.LanesRefined()) {
+    lane->control_points_map =
+        lanes_.RefitControlPoints(element, windows_.camera(), windows_.T_base_cam());
+    lane->control_points_map.erase(
+        lane->control_points_map.begin(),
+        lane->control_points_map.begin() + std::min(from, lane->control_points_map.size()));
+  } else {
+    const auto& cps = element.control_points_map;
+    lane->control_points_map.assign(cps.begin() + std::min(from, cps.size()), cps.end());
+  }
   lane->observations = static_cast<int>(element.Observations());
   lane->first_seen = element.first_seen;
   lane->last_seen = element.last_seen;

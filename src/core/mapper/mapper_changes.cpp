@@ -13,7 +13,7 @@ void SortUnique(std::vector<std::uint64_t>* ids) {
 
 }  // namespace
 
-MapChanges Mapper::ExportChanges(std::uint64_t since) const {
+MapChanges Mapper::ExportChanges(std::uint64_t since, const ChangesOptions& options) const {
   const ChangeLog& log = store_.changes();
   MapChanges out;
   out.revision = log.revision();
@@ -49,9 +49,18 @@ MapChanges Mapper::ExportChanges(std::uint64_t since) const {
   const bool refit = !windows_.LanesRefined();
   for (const LaneElement& element : store_.lanes()) {
     if (!refit && element.revision <= since) continue;
+    // The points before the first changed one are as the client has them; a lane exported
+    // first after `since` is new to it.
+    const std::size_t first_changed =
+        refit || element.exported_at > since ? 0 : log.LaneChangedFrom(element.id, since);
+    const std::size_t offset = first_changed > options.lane_context_points
+                                   ? first_changed - options.lane_context_points
+                                   : 0;
     MapLane lane;
-    if (ExportLane(element, &lane)) {
+    if (ExportLane(element, &lane, offset)) {
       out.map.lanes.push_back(std::move(lane));
+      out.lane_first_changed.push_back(first_changed);
+      out.lane_offsets.push_back(offset);
     } else if (!out.complete) {
       out.removed_lane_ids.push_back(element.id);
     }

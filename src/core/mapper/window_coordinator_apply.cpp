@@ -85,7 +85,7 @@ void WindowCoordinator::ApplyResult(const WindowResult& result, bool include_ret
       lane.control_points_map[k] = wl.control_points_map[j];
     }
     lane.optimized = true;
-    store_->Touch(&lane);
+    store_->Touch(&lane, static_cast<std::size_t>(std::max<std::int64_t>(0, offset)));
   }
 }
 

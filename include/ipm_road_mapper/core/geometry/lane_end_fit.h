@@ -55,8 +55,10 @@ std::vector<Eigen::Vector3d> FitLaneEnds(
 // changes only its stretch near the recent observations (and grows an end there), so the
 // cost does not grow with the lane. The result is the whole-lane result (FitLaneEnds holds
 // every control point no point reaches); the whole lane is fit when the part would differ.
+// *first_changed (if given): the index from which points may have changed (0: any).
 void FitLaneEndsNear(const LaneEndFitOptions& options, const std::vector<Eigen::Vector3d>& points,
                      const std::vector<Eigen::Vector3d>& extension_points,
-                     std::vector<Eigen::Vector3d>* control_points, int* added_at_start);
+                     std::vector<Eigen::Vector3d>* control_points, int* added_at_start,
+                     std::size_t* first_changed = nullptr);
 
 }  // namespace ipm_road_mapper

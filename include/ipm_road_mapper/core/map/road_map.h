@@ -75,6 +75,11 @@ struct MarkingElement {
   bool confirmed = false;
   // Every observation ever made, pruned ones included.
   std::size_t Observations() const { return history.size() + pruned; }
+  // Whether export shows it: seen at least twice (seen once, it is tentative).
+  bool Exported() const { return Observations() >= 2; }
+  // The revision of the first Touch that found it Exported() (0: not yet): an incremental
+  // export since an older revision sends it whole (the client never had it).
+  std::uint64_t exported_at = 0;
   bool Complete() const {
     return side_measured[0] && side_measured[1] && side_measured[2] && side_measured[3];
   }
@@ -111,6 +116,11 @@ struct LaneElement {
   bool optimized = false;  // control points refined by a lane residual
   // Every observation ever made, pruned ones included.
   std::size_t Observations() const { return history.size() + pruned; }
+  // Whether export shows it: seen at least twice (seen once, it is tentative).
+  bool Exported() const { return Observations() >= 2; }
+  // The revision of the first Touch that found it Exported() (0: not yet): an incremental
+  // export since an older revision sends it whole (the client never had it).
+  std::uint64_t exported_at = 0;
   // Observations of frames before this one no longer enter windows.
   std::size_t retired_before_frame = 0;
 };

@@ -1,12 +1,16 @@
 // The map's revisions: a counter the MapStore bumps on every change of an element's exported
 // form (MapStore::Touch), and the logs an incremental export needs so that it never scans
 // the retired markings: which retired markings changed at which revision, which element ids
-// left the map at which revision, and which retired slots another marking moved into (what
-// a shared snapshot's chunks follow). The logs are appended in revision order.
+// left the map at which revision, which retired slots another marking moved into (what
+// a shared snapshot's chunks follow), and for each lane from which control point on it
+// changed (so that a lane kilometers long that changed at its end costs its end only). The
+// logs are appended in revision order.
 #pragma once
 
+#include <Eigen/Core>
 #include <cstddef>
 #include <cstdint>
+#include <unordered_map>
 #include <utility>
 #include <vector>
 
@@ -25,6 +29,14 @@ class ChangeLog {
   void NoteRetired(std::uint64_t revision, std::uint64_t id);
   // Element `id` of `kind` left the map; gets a new revision.
   void NoteRemoved(ElementKind kind, std::uint64_t id);
+  // Lane `id` changed at `revision` from control point `first_changed` on (an index into
+  // its control points then; 0: the whole lane, e.g. points prepended or a re-fit).
+  void NoteLane(std::uint64_t revision, std::uint64_t id, std::size_t first_changed);
+  // The first control point of lane `id` that changed after `since` (the least index noted
+  // since then; 0 when nothing was noted: the whole lane). Points before it are as they
+  // were at `since`, as long as every writer that moved points reported a range no larger
+  // than the points it left in place (indices shift only with a 0).
+  std::size_t LaneChangedFrom(std::uint64_t id, std::uint64_t since) const;
   // Retired marking slot `index` (an index into the retired markings) holds another marking
   // now (MapStore::ReviveMarking moved the last one there); gets a new revision.
   void NoteRetiredMoved(std::size_t index);
@@ -53,6 +65,17 @@ class ChangeLog {
   std::vector<Entry> retired_;
   std::vector<Entry> removed_markings_, removed_lanes_;
   std::vector<Entry> retired_moved_;  // (revision, slot)
+  // Per lane, (revision, first changed point) with strictly increasing points: an entry
+  // whose point is no less than a newer one's never decides a minimum, so it is dropped;
+  // the least point after `since` is then the first entry after it. At most one entry per
+  // control point; a lane's entries go when it leaves the map.
+  std::unordered_map<std::uint64_t, std::vector<Entry>> lane_changes_;
 };
+
+// The first index at which `after` differs from `before` (their common length when one is
+// the other's start; after.size() when equal): the range a writer reports that replaced a
+// lane's control points whole (a merge, a join).
+std::size_t FirstChangedControlPoint(const std::vector<Eigen::Vector3d>& before,
+                                     const std::vector<Eigen::Vector3d>& after);
 
 }  // namespace ipm_road_mapper

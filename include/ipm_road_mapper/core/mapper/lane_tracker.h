@@ -52,9 +52,9 @@ class LaneTracker {
   void Start(int class_id, const LaneMeasurement& measurement,
              const std::vector<Eigen::Vector3d>& usable_map, const FrameRecord& frame);
   // Grows the lane's ends with this frame's usable points and refines them with the
-  // selected points of its recent observations.
-  void Grow(LaneElement* lane, std::size_t frame_index,
-            const std::vector<Eigen::Vector3d>& usable_map) const;
+  // selected points of its recent observations; returns the first control point it changed.
+  std::size_t Grow(LaneElement* lane, std::size_t frame_index,
+                   const std::vector<Eigen::Vector3d>& usable_map) const;
   void MergeLines();
 
   const MapperOptions& options_;

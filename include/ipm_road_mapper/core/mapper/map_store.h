@@ -72,7 +72,10 @@ class MapStore {
   // calls Touch: the element gets a new revision, and a retired marking is logged so that
   // an export finds it without scanning the retired ones.
   void Touch(MarkingElement* marking);
-  void Touch(LaneElement* lane);
+  // A lane's Touch also logs the first of its control points the write may have changed
+  // (ChangeLog::NoteLane): the default 0, the whole lane, is right for any writer, only
+  // slower to publish; a writer that moved the points from index k on only passes k.
+  void Touch(LaneElement* lane, std::size_t first_changed = 0);
   // Logs the live markings and lanes that left the map since the last call (merged away,
   // dropped as spurious or inconsistent, joined into another lane): the Mapper calls it at
   // the end of each step that may remove elements. Costs the live elements and lanes.

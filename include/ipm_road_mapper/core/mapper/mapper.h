@@ -95,8 +95,9 @@ class Mapper {
 
   // The incremental export (map_changes.h): what ExportMap's elements changed after
   // revision `since` (0: all of them), and the ids it no longer exports. Costs the live
-  // markings, the lanes and what changed; retired markings only when they changed.
-  MapChanges ExportChanges(std::uint64_t since) const;
+  // markings, the lanes and what changed; retired markings only when they changed; with
+  // `options.lane_context_points` a changed lane costs its changed part, not its length.
+  MapChanges ExportChanges(std::uint64_t since, const ChangesOptions& options = {}) const;
   // The live snapshot's export (what ExportMap gives with `max_trajectory_poses` newest
   // poses and no lane topology), in shared immutable storage: only the live markings, the
   // retired-marking chunks with a slot changed since the last call with `cache`, and the
@@ -151,7 +152,8 @@ class Mapper {
   void PruneHistories();
   // ExportMap's form of one element: false when export skips it (tentative, seen once).
   bool ExportMarking(const MarkingElement& element, MapMarking* marking) const;
-  bool ExportLane(const LaneElement& element, MapLane* lane) const;
+  // A lane's control points from index `from` on only (a tail for ExportChanges).
+  bool ExportLane(const LaneElement& element, MapLane* lane, std::size_t from = 0) const;
   // The exported name of class `class_id` ("class_<id>" when the table has none).
   std::string ClassName(int class_id) const;
   // The extrinsic fields of an export.
