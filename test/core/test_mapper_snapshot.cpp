@@ -2,7 +2,8 @@
 // gives, on a scripted drive with the back end solving windows: arrows mapped, retired, moved
 // by results, re-observed on the way back (revived: the last retired marking moves into the
 // freed slot), moved again by the final solve, then a reset; and the chunks and lanes that
-// did not change are the previous snapshot's (shared, not copied).
+// did not change are the previous snapshot's (shared, not copied), as are the point chunks of
+// a lane before the first point that changed.
 #include <gtest/gtest.h>
 
 #include <cmath>
@@ -67,9 +68,11 @@ TEST(MapperSnapshot, EqualsExportMapAndSharesWhatDidNotChange) {
   options.backend.synchronous = true;
   options.lanes.join.enabled = true;
   Mapper mapper(options, TestClasses(), TestExtrinsic());
-  SnapshotCache cache(/*retired_chunk_slots=*/2);
+  SnapshotCache cache(/*retired_chunk_slots=*/2, /*lane_chunk_points=*/4);
   SharedVectorMap previous;
   std::size_t revivals = 0, shared_chunks = 0, shared_lanes = 0, max_retired = 0;
+  // Lanes rebuilt that kept some of their point chunks, and the points they did not copy.
+  std::size_t partly_rebuilt = 0, points_not_copied = 0;
   auto check = [&](const std::string& when) {
     SCOPED_TRACE(when);
     const SharedVectorMap snapshot = mapper.ExportSnapshot(5, &cache);
@@ -82,9 +85,25 @@ TEST(MapperSnapshot, EqualsExportMapAndSharesWhatDidNotChange) {
         shared_chunks += snapshot.marking_chunks[k] == previous.marking_chunks[j];
       }
     }
+    std::size_t lane_points = 0;
     for (const auto& lane : snapshot.lanes) {
-      for (const auto& old : previous.lanes) shared_lanes += lane == old;
+      lane_points += lane->PointCount();
+      for (const auto& old : previous.lanes) {
+        shared_lanes += lane == old;
+        if (lane == old || lane->fields.id != old->fields.id) continue;
+        // A rebuilt lane: its leading chunks may be the previous export's own.
+        std::size_t kept = 0;
+        while (kept < lane->point_chunks.size() && kept < old->point_chunks.size() &&
+               lane->point_chunks[kept] == old->point_chunks[kept]) {
+          ++kept;
+        }
+        if (kept > 0) {
+          ++partly_rebuilt;
+          points_not_copied += 4 * kept;
+        }
+      }
     }
+    EXPECT_LE(cache.lane_points_built, lane_points);
     EXPECT_LE(cache.chunks_built, snapshot.marking_chunks.size() - 1);
     previous = snapshot;
   };
@@ -104,6 +123,9 @@ TEST(MapperSnapshot, EqualsExportMapAndSharesWhatDidNotChange) {
   EXPECT_GT(revivals, 0u);
   EXPECT_GT(shared_chunks, 20u);
   EXPECT_GT(shared_lanes, 0u);
+  // The lane grew and moved near its end while its start stood: its start was not copied.
+  EXPECT_GT(partly_rebuilt, 10u);
+  EXPECT_GT(points_not_copied, 100u);
   mapper.Reset();
   const SharedVectorMap empty = mapper.ExportSnapshot(5, &cache);
   EXPECT_EQ(VectorMapToJson(empty.ToVectorMap()), Expected(mapper, 5));

@@ -251,7 +251,8 @@ TEST(MapSnapshot, FullMapLinksTheLaneTopologyTheSnapshotSkips) {
   ASSERT_EQ(full->lanes.size(), 2u);
   EXPECT_EQ(full->lanes[0].successors, std::vector<std::uint64_t>{2});
   EXPECT_EQ(full->lanes[1].predecessors, std::vector<std::uint64_t>{1});
-  EXPECT_TRUE(snapshot.map->lanes[0]->successors.empty());  // the snapshot's own map untouched
+  EXPECT_TRUE(
+      snapshot.map->lanes[0]->fields.successors.empty());  // the snapshot's own map untouched
 }
 
 }  // namespace

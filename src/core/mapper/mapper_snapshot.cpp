@@ -56,21 +56,41 @@ SharedVectorMap Mapper::ExportSnapshot(std::size_t max_trajectory_poses,
   out.marking_chunks.insert(out.marking_chunks.end(), cache->retired_chunks.begin(),
                             cache->retired_chunks.end());
 
-  // Lanes: re-used while their revision stands; lanes re-fit at export follow the extrinsic
-  // and every pose, so then all are exported afresh.
+  // Lanes: re-used while their revision stands; a changed lane keeps the chunks before the
+  // first point that changed since the last export (ChangeLog lane ranges) and rebuilds the
+  // rest. Lanes re-fit at export follow the extrinsic and every pose, so then all are
+  // exported afresh and whole.
   const bool refit = !windows_.LanesRefined();
+  const std::size_t chunk_points = cache->lane_chunk_points;
   decltype(cache->lanes) lanes;
   lanes.reserve(store_.lanes().size());
   cache->lanes_built = 0;
+  cache->lane_points_built = 0;
   for (const LaneElement& element : store_.lanes()) {
-    std::shared_ptr<const MapLane> lane;
+    std::shared_ptr<const SharedLane> lane;
     const auto cached = cache->lanes.find(element.id);
-    if (!refit && cached != cache->lanes.end() && cached->second.first == element.revision) {
+    const bool have = !refit && cached != cache->lanes.end();
+    if (have && cached->second.first == element.revision) {
       lane = cached->second.second;
     } else {
+      // Whole chunks before the first changed point, and no more than the lane still has.
+      std::size_t keep = 0;
+      if (have) {
+        const SharedLane& before = *cached->second.second;
+        const std::size_t from = std::min({log.LaneChangedFrom(element.id, since),
+                                           element.control_points_map.size(), before.PointCount()});
+        keep = from / chunk_points;
+      }
       MapLane exported;
-      if (!ExportLane(element, &exported)) continue;
-      lane = std::make_shared<const MapLane>(std::move(exported));
+      if (!ExportLane(element, &exported, keep * chunk_points)) continue;
+      cache->lane_points_built += exported.control_points_map.size();
+      std::shared_ptr<SharedLane> built = ShareLane(std::move(exported), chunk_points);
+      if (keep > 0) {
+        const auto& old_chunks = cached->second.second->point_chunks;
+        built->point_chunks.insert(built->point_chunks.begin(), old_chunks.begin(),
+                                   old_chunks.begin() + keep);
+      }
+      lane = std::move(built);
       ++cache->lanes_built;
     }
     out.lanes.push_back(lane);
