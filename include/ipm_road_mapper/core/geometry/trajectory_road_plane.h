@@ -26,7 +26,7 @@ namespace ipm_road_mapper {
 
 // How the road plane is estimated from the trajectory (config section `ipm`).
 struct TrajectoryRoadPlaneOptions {
-  double grade_length_m = 10.0;       // path behind the vehicle whose heights give the grade
+  double grade_length_m = 30.0;       // path behind the vehicle whose heights give the grade
   double cross_slope_window_s = 1.5;  // the body's roll is averaged over this long
 };
 
