@@ -1,5 +1,7 @@
 // The window's lane pixels: each is assigned to the spline segment where its ray meets the
-// lane, also where the road ahead is not in the viewing frame's plane (a crest).
+// road, also where the road ahead is not in the viewing frame's plane (a crest, a pitched
+// body): on the lane's own surface (the opt-in), on the surface the poses give there, and on
+// the viewing frame's front-end ground beyond the poses.
 #include <gtest/gtest.h>
 
 #include <cmath>
@@ -75,6 +77,81 @@ TEST(CollectLanePixels, AssignsAPixelBeyondACrestToTheSegmentItsRayMeets) {
     EXPECT_NEAR(pixel.q_map.y(), 3.5, 0.05);
     EXPECT_NEAR(pixel.q_map.z(), CrestHeight(x_true[i]), 0.01);
   }
+}
+
+// The crest's snapshot with the frames that drove over it, every metre from -10 m to 45 m, each
+// resting on the road (on the surface, pitched by its slope); the measurement is frame 7's.
+WindowSnapshot CrestSnapshotWithTheDrive(const std::vector<double>& x_on_lane_m) {
+  WindowSnapshot snapshot = CrestSnapshot(x_on_lane_m);
+  const WindowFrame viewing = snapshot.frames.front();
+  snapshot.frames.clear();
+  std::size_t index = 0;
+  for (double x = -10.0; x <= 45.0; x += 1.0, ++index) {
+    WindowFrame frame;
+    frame.index = index == viewing.index ? 1000 : index;  // frame 7 is the viewing one
+    frame.T_map_base.linear() = RotationFromRpy(0.0, -std::atan(0.06 - 0.001 * x), 0.0);
+    frame.T_map_base.translation() = Eigen::Vector3d(x, 0.0, CrestHeight(x));
+    if (x == 0.0) frame = viewing;
+    snapshot.frames.push_back(frame);
+  }
+  return snapshot;
+}
+
+TEST(CollectLanePixels, TakesTheRoadThePosesGiveBeyondACrest) {
+  // Without the lane-surface option: the pixel's ground point is re-intersected with the road
+  // surface of the frames that drove there (RoadSurfaceNear), not left on the viewing frame's
+  // plane.
+  const std::vector<double> x_true = {12.0, 16.5, 25.0, 31.0};
+  const WindowSnapshot snapshot = CrestSnapshotWithTheDrive(x_true);
+  BackendOptions options;
+  options.max_lane_points_per_observation = 100;
+  ASSERT_FALSE(options.lane_pixels_on_lane_surface);
+  window_solve::WindowState state(snapshot);
+  window_solve::CollectLanePixels(snapshot, options, &state);
+  ASSERT_EQ(state.lane_pixels.size(), x_true.size());
+  for (std::size_t i = 0; i < x_true.size(); ++i) {
+    const window_solve::LanePixel& pixel = state.lane_pixels[i];
+    const double x_start = -6.0 + 3.0 * (pixel.segment + 1);
+    EXPECT_LE(x_start, x_true[i] + 1e-6) << "pixel at x = " << x_true[i];
+    EXPECT_GE(x_start + 3.0, x_true[i] - 1e-6) << "pixel at x = " << x_true[i];
+    EXPECT_NEAR(pixel.q_map.x(), x_true[i], 0.15);
+    EXPECT_NEAR(pixel.q_map.y(), 3.5, 0.05);
+    EXPECT_NEAR(pixel.q_map.z(), CrestHeight(x_true[i]), 0.02);
+  }
+}
+
+TEST(CollectLanePixels, TakesTheViewingFramesGroundBeyondThePoses) {
+  // One frame, pitched 0.3 deg nose down on flat ground, its front end's ground the road
+  // (level): a pixel of a line 31 m ahead goes onto that ground, not onto the pitched plane
+  // of base_link, which puts it 2 m farther.
+  WindowSnapshot snapshot;
+  snapshot.camera = test::Intrinsics1280x720();
+  snapshot.T_base_cam = test::MountedCamera(0.0, 4.0 * kDeg, 0.0, Eigen::Vector3d(1.5, 0.0, 1.5));
+  WindowFrame frame;
+  frame.index = 3;
+  frame.T_map_base.linear() = RotationFromRpy(0.0, 0.3 * kDeg, 0.0);
+  frame.ground_base.normal = frame.T_map_base.linear().transpose() * Eigen::Vector3d::UnitZ();
+  snapshot.frames.push_back(frame);
+  WindowLane lane;
+  for (double x = -6.0; x <= 60.0; x += 3.0) lane.control_points_map.emplace_back(x, 3.5, 0.0);
+  LaneMeasurement measurement;
+  measurement.frame_index = frame.index;
+  LanePoint point;
+  const Eigen::Isometry3d T_cam_map = (frame.T_map_base * snapshot.T_base_cam).inverse();
+  ASSERT_TRUE(
+      PinholeCamera(snapshot.camera)
+          .Project(Eigen::Vector3d(T_cam_map * Eigen::Vector3d(31.0, 3.5, 0.0)), &point.uv));
+  measurement.points.push_back(point);
+  measurement.selected.push_back(1);
+  lane.measurements.push_back(measurement);
+  snapshot.lanes.push_back(lane);
+  BackendOptions options;
+  window_solve::WindowState state(snapshot);
+  window_solve::CollectLanePixels(snapshot, options, &state);
+  ASSERT_EQ(state.lane_pixels.size(), 1u);
+  EXPECT_NEAR(state.lane_pixels[0].q_map.x(), 31.0, 1e-6);
+  EXPECT_NEAR(state.lane_pixels[0].q_map.y(), 3.5, 1e-6);
+  EXPECT_EQ(state.lane_pixels[0].segment, 11);  // control points 12 and 13: x = 30 and 33 m
 }
 
 }  // namespace
