@@ -1,7 +1,6 @@
 // The window's lane pixels: each is assigned to the spline segment where its ray meets the
 // road, also where the road ahead is not in the viewing frame's plane (a crest, a pitched
-// body): on the lane's own surface (the opt-in), on the surface the poses give there, and on
-// the viewing frame's front-end ground beyond the poses.
+// body): on the lane's own surface (the opt-in) and on the viewing frame's front-end ground.
 #include <gtest/gtest.h>
 
 #include <cmath>
@@ -79,48 +78,7 @@ TEST(CollectLanePixels, AssignsAPixelBeyondACrestToTheSegmentItsRayMeets) {
   }
 }
 
-// The crest's snapshot with the frames that drove over it, every metre from -10 m to 45 m, each
-// resting on the road (on the surface, pitched by its slope); the measurement is frame 7's.
-WindowSnapshot CrestSnapshotWithTheDrive(const std::vector<double>& x_on_lane_m) {
-  WindowSnapshot snapshot = CrestSnapshot(x_on_lane_m);
-  const WindowFrame viewing = snapshot.frames.front();
-  snapshot.frames.clear();
-  std::size_t index = 0;
-  for (double x = -10.0; x <= 45.0; x += 1.0, ++index) {
-    WindowFrame frame;
-    frame.index = index == viewing.index ? 1000 : index;  // frame 7 is the viewing one
-    frame.T_map_base.linear() = RotationFromRpy(0.0, -std::atan(0.06 - 0.001 * x), 0.0);
-    frame.T_map_base.translation() = Eigen::Vector3d(x, 0.0, CrestHeight(x));
-    if (x == 0.0) frame = viewing;
-    snapshot.frames.push_back(frame);
-  }
-  return snapshot;
-}
-
-TEST(CollectLanePixels, TakesTheRoadThePosesGiveBeyondACrest) {
-  // Without the lane-surface option: the pixel's ground point is re-intersected with the road
-  // surface of the frames that drove there (RoadSurfaceNear), not left on the viewing frame's
-  // plane.
-  const std::vector<double> x_true = {12.0, 16.5, 25.0, 31.0};
-  const WindowSnapshot snapshot = CrestSnapshotWithTheDrive(x_true);
-  BackendOptions options;
-  options.max_lane_points_per_observation = 100;
-  ASSERT_FALSE(options.lane_pixels_on_lane_surface);
-  window_solve::WindowState state(snapshot);
-  window_solve::CollectLanePixels(snapshot, options, &state);
-  ASSERT_EQ(state.lane_pixels.size(), x_true.size());
-  for (std::size_t i = 0; i < x_true.size(); ++i) {
-    const window_solve::LanePixel& pixel = state.lane_pixels[i];
-    const double x_start = -6.0 + 3.0 * (pixel.segment + 1);
-    EXPECT_LE(x_start, x_true[i] + 1e-6) << "pixel at x = " << x_true[i];
-    EXPECT_GE(x_start + 3.0, x_true[i] - 1e-6) << "pixel at x = " << x_true[i];
-    EXPECT_NEAR(pixel.q_map.x(), x_true[i], 0.15);
-    EXPECT_NEAR(pixel.q_map.y(), 3.5, 0.05);
-    EXPECT_NEAR(pixel.q_map.z(), CrestHeight(x_true[i]), 0.02);
-  }
-}
-
-TEST(CollectLanePixels, TakesTheViewingFramesGroundBeyondThePoses) {
+TEST(CollectLanePixels, TakesTheViewingFramesFrontEndGround) {
   // One frame, pitched 0.3 deg nose down on flat ground, its front end's ground the road
   // (level): a pixel of a line 31 m ahead goes onto that ground, not onto the pitched plane
   // of base_link, which puts it 2 m farther.

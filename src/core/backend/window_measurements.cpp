@@ -4,6 +4,7 @@
 
 #include "ipm_road_mapper/core/frontend/marking_measurement.h"
 #include "ipm_road_mapper/core/geometry/catmull_rom_spline.h"
+#include "ipm_road_mapper/core/geometry/ipm.h"
 #include "ipm_road_mapper/core/geometry/road_surface.h"
 
 namespace ipm_road_mapper {
@@ -76,48 +77,24 @@ void CollectCornerMeasurements(const WindowSnapshot& snapshot, const BackendOpti
 
 namespace {
 
-// Re-intersections of a lane pixel's ray with the road the window's poses give (OntoRoad).
-constexpr int kRoadSurfaceIterations = 3;
-
-// The ray of pixel uv from T_map_cam met with `plane` (map frame); false when it does not
-// descend to it ahead of the camera.
-bool IntersectRay(const Eigen::Vector3d& center_map, const Eigen::Vector3d& ray_map,
-                  const RoadPlane& plane, Eigen::Vector3d* p_map) {
-  const double descent = plane.normal.dot(ray_map);
-  if (descent >= 0.0) return false;
-  const double lambda = plane.normal.dot(plane.point - center_map) / descent;
-  if (!(lambda > 0.0)) return false;
-  *p_map = center_map + lambda * ray_map;
-  return true;
-}
-
-// A lane pixel's ground point on the road: first the viewing frame's own ground (the front
-// end's, its trajectory's road plane), then, where the window's poses drove within
-// road_plane_radius_m of the point, the road surface they give there (RoadSurfaceNear),
-// kRoadSurfaceIterations times. Why: the road ahead is not in the viewing frame's base plane
-// (the body's pitch, a grade change, a crest, waves): flat-ground IPM there puts the pixel
-// meters along and, scaled by its lateral offset, sideways from its line, so it was matched
-// to the wrong segment (its PPSR measured the distance to a wrong chord of the projected
-// line) or dropped by the distance gate, the far line on one side more than the others: a
-// bias of the camera's roll on hills.
-bool OntoRoad(const PinholeCamera& camera, const Eigen::Isometry3d& T_map_cam,
-              const Eigen::Isometry3d& T_map_base, const RoadPlane& ground_base,
-              const std::vector<Eigen::Isometry3d>& poses, double radius_m,
-              const Eigen::Vector2d& uv, Eigen::Vector3d* p_map) {
+// A lane pixel's ground point on the viewing frame's own ground (the plane its front end
+// mapped the frame's pixels onto: FrameRecord::ground_base, base_link's z = 0 unless
+// ipm.ground is trajectory), so that the segment it is given is where the front end put the
+// lane's points. False when the ray does not descend to that plane ahead of the camera.
+// (Re-intersecting it with the road surface the window's poses give there, RoadSurfaceNear,
+// was measured and is not done: docs/backend.md, "The front end's ground".)
+bool OntoFrameGround(const PinholeCamera& camera, const Eigen::Isometry3d& T_map_cam,
+                     const Eigen::Isometry3d& T_map_base, const RoadPlane& ground_base,
+                     const Eigen::Vector2d& uv, Eigen::Vector3d* p_map) {
   const Eigen::Vector2d xy = camera.UndistortToNormalized(uv);
   const Eigen::Vector3d ray_map = T_map_cam.linear() * Eigen::Vector3d(xy.x(), xy.y(), 1.0);
-  const Eigen::Vector3d center_map = T_map_cam.translation();
-  RoadPlane plane;
-  plane.point = T_map_base * ground_base.point;
-  plane.normal = T_map_base.linear() * ground_base.normal;
-  if (!IntersectRay(center_map, ray_map, plane, p_map)) return false;
-  for (int iteration = 0; iteration < kRoadSurfaceIterations; ++iteration) {
-    const RoadSurfaceEstimate road = RoadSurfaceNear(poses, *p_map, radius_m);
-    if (road.frames == 0 || road.distance_m > radius_m) break;  // beyond the poses: extrapolated
-    Eigen::Vector3d p;
-    if (!IntersectRay(center_map, ray_map, road.plane, &p)) break;
-    *p_map = p;
-  }
+  const Eigen::Vector3d normal_map = T_map_base.linear() * ground_base.normal;
+  const double descent = normal_map.dot(ray_map);
+  if (!(descent < -Ipm::kMinRayDescent * ray_map.norm())) return false;
+  const double lambda =
+      normal_map.dot(T_map_base * ground_base.point - T_map_cam.translation()) / descent;
+  if (!(lambda > 0.0)) return false;
+  *p_map = T_map_cam.translation() + lambda * ray_map;
   return true;
 }
 
@@ -194,10 +171,8 @@ void CollectLanePixels(const WindowSnapshot& snapshot, const BackendOptions& opt
       for (double k = 0.0; k < static_cast<double>(selected.size()); k += step) {
         const LanePoint& point = m.points[selected[static_cast<std::size_t>(k)]];
         Eigen::Vector3d p_map;
-        if (!OntoRoad(camera, T_map_cam, T_map_base, ground_base, state->poses,
-                      options.road_plane_radius_m, point.uv, &p_map)) {
+        if (!OntoFrameGround(camera, T_map_cam, T_map_base, ground_base, point.uv, &p_map))
           continue;
-        }
         CatmullRomSpline::ClosestPoint closest = spline.FindClosest(p_map);
         if (closest.distance_m > options.max_lane_pixel_distance_m) continue;
         if (options.lane_pixels_on_lane_surface &&

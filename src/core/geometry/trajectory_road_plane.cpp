@@ -10,35 +10,27 @@ namespace {
 constexpr std::size_t kMinQuadraticPoints = 6;
 
 // The slope dz/ds at the newest pose of the heights of the poses within grade_length_m of path
-// behind it; NaN when the path there is shorter than kMinGradePathM. s is the distance
-// travelled back along the path (negative), from the stamps at the mean speed over the span
-// (its chord over its duration): summed steps between poses would add up the odometry's
-// per-message jitter (0.4 m a message inflates a 0.5 m step to 0.8 m). Heights are taken
-// relative to the newest's, so that equal heights give a slope of exactly 0.
+// behind it, s the horizontal distance travelled back along the path (negative); NaN when the
+// path there is shorter than kMinGradePathM. Heights are taken relative to the newest's, so
+// that equal heights give a slope of exactly 0.
 double PathGrade(const std::vector<StampedPose>& recent, double grade_length_m) {
-  const StampedPose& newest = recent.back();
-  const Eigen::Vector3d p_newest = newest.T_map_base.translation();
-  // The oldest pose within grade_length_m (chord) of the newest.
-  std::size_t first = recent.size() - 1;
-  while (first > 0 && (recent[first - 1].T_map_base.translation() - p_newest).head<2>().norm() <=
-                          grade_length_m) {
-    --first;
-  }
-  const double duration_s = newest.stamp - recent[first].stamp;
-  const double chord_m = (recent[first].T_map_base.translation() - p_newest).head<2>().norm();
-  if (!(duration_s > 0.0)) return std::numeric_limits<double>::quiet_NaN();
-  const double speed_mps = chord_m / duration_s;
+  const Eigen::Vector3d newest = recent.back().T_map_base.translation();
   std::vector<Eigen::Vector2d> s_dz;  // (s, z - z_newest)
-  for (std::size_t i = first; i < recent.size(); ++i) {
-    s_dz.emplace_back(speed_mps * (recent[i].stamp - newest.stamp),
-                      recent[i].T_map_base.translation().z() - p_newest.z());
+  s_dz.emplace_back(0.0, 0.0);
+  double s = 0.0;
+  for (std::size_t i = recent.size() - 1; i > 0; --i) {
+    const Eigen::Vector3d a = recent[i].T_map_base.translation();
+    const Eigen::Vector3d b = recent[i - 1].T_map_base.translation();
+    s -= (a - b).head<2>().norm();
+    if (-s > grade_length_m) break;
+    s_dz.emplace_back(s, b.z() - newest.z());
   }
-  if (-s_dz.front().x() < kMinGradePathM) return std::numeric_limits<double>::quiet_NaN();
+  if (-s_dz.back().x() < kMinGradePathM) return std::numeric_limits<double>::quiet_NaN();
   // z = a + b s + c s^2 by least squares where the path spans half the length or more (a
   // grade that changes, a crest: the slope at s = 0, not the chord's lagging one), else a
   // line; the slope at the newest pose is b.
   const bool quadratic =
-      -s_dz.front().x() >= 0.5 * grade_length_m && s_dz.size() >= kMinQuadraticPoints;
+      -s_dz.back().x() >= 0.5 * grade_length_m && s_dz.size() >= kMinQuadraticPoints;
   const int terms = quadratic ? 3 : 2;
   Eigen::Matrix3d normal = Eigen::Matrix3d::Zero();
   Eigen::Vector3d rhs = Eigen::Vector3d::Zero();

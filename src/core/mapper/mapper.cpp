@@ -27,15 +27,16 @@ MapperOptions WithEffectiveGates(MapperOptions options) {
 RoadPlane FrontEndGround(const IpmOptions& options, const std::vector<FrameRecord>& frames,
                          double stamp, const Eigen::Isometry3d& T_map_base_odom) {
   if (options.ground == IpmGround::kBaseLink) return RoadPlane();
-  // The frames within both windows (grade_length_m of chord, cross_slope_window_s), and one
-  // beyond them.
+  // The frames within both windows, and one beyond them.
   std::size_t first = frames.size();
+  double path_m = 0.0;
+  Eigen::Vector3d previous = T_map_base_odom.translation();
   while (first > 0) {
     const FrameRecord& frame = frames[first - 1];
+    path_m += (previous - frame.T_map_base_odom.translation()).head<2>().norm();
+    previous = frame.T_map_base_odom.translation();
     --first;
-    const double chord_m =
-        (T_map_base_odom.translation() - frame.T_map_base_odom.translation()).head<2>().norm();
-    if (chord_m > options.road_plane.grade_length_m &&
+    if (path_m > options.road_plane.grade_length_m &&
         stamp - frame.stamp > options.road_plane.cross_slope_window_s) {
       break;
     }

@@ -29,7 +29,7 @@ enum class IpmGround {
 struct IpmOptions {
   double max_range_m = 40.0;  // ground points farther than this are rejected
   IpmErrorModel error_model;  // Omega_p inputs (docs/design.md defaults)
-  IpmGround ground = IpmGround::kTrajectory;
+  IpmGround ground = IpmGround::kBaseLink;
   TrajectoryRoadPlaneOptions road_plane;  // the trajectory's road plane (ground: trajectory)
 };
 
