@@ -65,6 +65,21 @@ TEST(MapperOptions, UnknownKeysNameTheirPath) {
   EXPECT_EQ(ErrorOf([] { LoadMapperOptions(ReaderOf("ipm: 3")); }), "ipm: must be a map");
 }
 
+TEST(MapperOptions, IpmGroundIsBaseLinkByDefaultAndTrajectoryOnRequest) {
+  EXPECT_EQ(MapperOptions().ipm.ground, IpmGround::kBaseLink);
+  const MapperOptions o = LoadMapperOptions(
+      ReaderOf("ipm: {ground: trajectory, road_grade_length_m: 20, road_cross_slope_window_s: 2}"));
+  EXPECT_EQ(o.ipm.ground, IpmGround::kTrajectory);
+  EXPECT_EQ(o.ipm.road_plane.grade_length_m, 20.0);
+  EXPECT_EQ(o.ipm.road_plane.cross_slope_window_s, 2.0);
+  EXPECT_NE(ToString(o).find("ipm.ground: trajectory\n"), std::string::npos);
+  EXPECT_EQ(
+      ErrorOf([] { LoadMapperOptions(ReaderOf("ipm: {ground: road}")); }).rfind("ipm.ground", 0),
+      0u);
+  EXPECT_FALSE(
+      ErrorOf([] { LoadMapperOptions(ReaderOf("ipm: {road_grade_length_m: 0}")); }).empty());
+}
+
 TEST(MapperOptions, ShippedMapperYamlLoads) {
   const std::string path = kConfigDir + "/mapper.yaml";
   MapperOptions o;

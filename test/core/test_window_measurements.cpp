@@ -1,5 +1,6 @@
 // The window's lane pixels: each is assigned to the spline segment where its ray meets the
-// lane, also where the road ahead is not in the viewing frame's plane (a crest).
+// road, also where the road ahead is not in the viewing frame's plane (a crest, a pitched
+// body): on the lane's own surface (the opt-in) and on the viewing frame's front-end ground.
 #include <gtest/gtest.h>
 
 #include <cmath>
@@ -75,6 +76,40 @@ TEST(CollectLanePixels, AssignsAPixelBeyondACrestToTheSegmentItsRayMeets) {
     EXPECT_NEAR(pixel.q_map.y(), 3.5, 0.05);
     EXPECT_NEAR(pixel.q_map.z(), CrestHeight(x_true[i]), 0.01);
   }
+}
+
+TEST(CollectLanePixels, TakesTheViewingFramesFrontEndGround) {
+  // One frame, pitched 0.3 deg nose down on flat ground, its front end's ground the road
+  // (level): a pixel of a line 31 m ahead goes onto that ground, not onto the pitched plane
+  // of base_link, which puts it 2 m farther.
+  WindowSnapshot snapshot;
+  snapshot.camera = test::Intrinsics1280x720();
+  snapshot.T_base_cam = test::MountedCamera(0.0, 4.0 * kDeg, 0.0, Eigen::Vector3d(1.5, 0.0, 1.5));
+  WindowFrame frame;
+  frame.index = 3;
+  frame.T_map_base.linear() = RotationFromRpy(0.0, 0.3 * kDeg, 0.0);
+  frame.ground_base.normal = frame.T_map_base.linear().transpose() * Eigen::Vector3d::UnitZ();
+  snapshot.frames.push_back(frame);
+  WindowLane lane;
+  for (double x = -6.0; x <= 60.0; x += 3.0) lane.control_points_map.emplace_back(x, 3.5, 0.0);
+  LaneMeasurement measurement;
+  measurement.frame_index = frame.index;
+  LanePoint point;
+  const Eigen::Isometry3d T_cam_map = (frame.T_map_base * snapshot.T_base_cam).inverse();
+  ASSERT_TRUE(
+      PinholeCamera(snapshot.camera)
+          .Project(Eigen::Vector3d(T_cam_map * Eigen::Vector3d(31.0, 3.5, 0.0)), &point.uv));
+  measurement.points.push_back(point);
+  measurement.selected.push_back(1);
+  lane.measurements.push_back(measurement);
+  snapshot.lanes.push_back(lane);
+  BackendOptions options;
+  window_solve::WindowState state(snapshot);
+  window_solve::CollectLanePixels(snapshot, options, &state);
+  ASSERT_EQ(state.lane_pixels.size(), 1u);
+  EXPECT_NEAR(state.lane_pixels[0].q_map.x(), 31.0, 1e-6);
+  EXPECT_NEAR(state.lane_pixels[0].q_map.y(), 3.5, 1e-6);
+  EXPECT_EQ(state.lane_pixels[0].segment, 11);  // control points 12 and 13: x = 30 and 33 m
 }
 
 }  // namespace

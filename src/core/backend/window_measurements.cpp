@@ -77,6 +77,27 @@ void CollectCornerMeasurements(const WindowSnapshot& snapshot, const BackendOpti
 
 namespace {
 
+// A lane pixel's ground point on the viewing frame's own ground (the plane its front end
+// mapped the frame's pixels onto: FrameRecord::ground_base, base_link's z = 0 unless
+// ipm.ground is trajectory), so that the segment it is given is where the front end put the
+// lane's points. False when the ray does not descend to that plane ahead of the camera.
+// (Re-intersecting it with the road surface the window's poses give there, RoadSurfaceNear,
+// was measured and is not done: docs/backend.md, "The front end's ground".)
+bool OntoFrameGround(const PinholeCamera& camera, const Eigen::Isometry3d& T_map_cam,
+                     const Eigen::Isometry3d& T_map_base, const RoadPlane& ground_base,
+                     const Eigen::Vector2d& uv, Eigen::Vector3d* p_map) {
+  const Eigen::Vector2d xy = camera.UndistortToNormalized(uv);
+  const Eigen::Vector3d ray_map = T_map_cam.linear() * Eigen::Vector3d(xy.x(), xy.y(), 1.0);
+  const Eigen::Vector3d normal_map = T_map_base.linear() * ground_base.normal;
+  const double descent = normal_map.dot(ray_map);
+  if (!(descent < -Ipm::kMinRayDescent * ray_map.norm())) return false;
+  const double lambda =
+      normal_map.dot(T_map_base * ground_base.point - T_map_cam.translation()) / descent;
+  if (!(lambda > 0.0)) return false;
+  *p_map = T_map_cam.translation() + lambda * ray_map;
+  return true;
+}
+
 // Re-intersections of a lane pixel's ray with the lane's own surface (OntoLaneSurface).
 constexpr int kLaneSurfaceIterations = 3;
 
@@ -131,7 +152,6 @@ bool OntoLaneSurface(const PinholeCamera& camera, const Eigen::Isometry3d& T_map
 void CollectLanePixels(const WindowSnapshot& snapshot, const BackendOptions& options,
                        WindowState* state) {
   const PinholeCamera camera(snapshot.camera);
-  const Ipm ipm(camera, snapshot.T_base_cam, 1e9);
   for (std::size_t l = 0; l < snapshot.lanes.size(); ++l) {
     const WindowLane& lane = snapshot.lanes[l];
     if (lane.control_points_map.size() < 4) continue;
@@ -146,16 +166,17 @@ void CollectLanePixels(const WindowSnapshot& snapshot, const BackendOptions& opt
       const std::size_t cap = static_cast<std::size_t>(options.max_lane_points_per_observation);
       const double step = selected.size() > cap ? static_cast<double>(selected.size()) / cap : 1.0;
       const Eigen::Isometry3d T_map_base = state->frames[slot->second].ToIsometry();
+      const Eigen::Isometry3d T_map_cam = T_map_base * snapshot.T_base_cam;
+      const RoadPlane& ground_base = snapshot.frames[slot->second].ground_base;
       for (double k = 0.0; k < static_cast<double>(selected.size()); k += step) {
         const LanePoint& point = m.points[selected[static_cast<std::size_t>(k)]];
-        Eigen::Vector3d p_base;
-        if (ipm.PixelToGround(point.uv, &p_base) != IpmStatus::kOk) continue;
-        Eigen::Vector3d p_map = T_map_base * p_base;
+        Eigen::Vector3d p_map;
+        if (!OntoFrameGround(camera, T_map_cam, T_map_base, ground_base, point.uv, &p_map))
+          continue;
         CatmullRomSpline::ClosestPoint closest = spline.FindClosest(p_map);
         if (closest.distance_m > options.max_lane_pixel_distance_m) continue;
         if (options.lane_pixels_on_lane_surface &&
-            !OntoLaneSurface(camera, T_map_base * snapshot.T_base_cam, T_map_base, point.uv, spline,
-                             &p_map, &closest)) {
+            !OntoLaneSurface(camera, T_map_cam, T_map_base, point.uv, spline, &p_map, &closest)) {
           continue;
         }
         if (closest.s <= 0.0 || closest.s >= spline.NumSegments()) continue;  // past an end

@@ -286,7 +286,7 @@ GeometryOutcome ExtractLane(const Run* runs, int run_count, const ClassInfo& cla
         const Eigen::Vector2d uv(0.5 * (runs[i].first_col + runs[i].last_col), row);
         LanePoint point;
         if (ipm.PixelToGround(uv, &point.p_base) != IpmStatus::kOk) continue;
-        point.p_base.z() = 0.0;  // on the ground plane by definition (drop rounding)
+        point.p_base = ipm.OnGround(point.p_base.head<2>());  // on the ground (drop rounding)
         const std::optional<IpmUncertainty> uncertainty =
             ComputeIpmUncertainty(ipm.camera(), ipm.T_base_cam(), uv, error_model);
         if (!uncertainty) continue;
@@ -325,7 +325,7 @@ bool SetMarkingRectangle(const Ipm& ipm, const IpmErrorModel& error_model,
   const std::array<Eigen::Vector2d, 4> rectangle =
       extraction::BoundingRectangle(marking->outline_base, axis_base);
   for (int i = 0; i < 4; ++i) {
-    marking->corners_base[i] = Eigen::Vector3d(rectangle[i].x(), rectangle[i].y(), 0.0);
+    marking->corners_base[i] = ipm.OnGround(rectangle[i]);
   }
   extraction::OrderCornersCanonically(&marking->corners_base);
   extraction::LabelSides(marking);

@@ -183,10 +183,13 @@ void LaneTracker::Start(int class_id, const LaneMeasurement& measurement,
 std::vector<Eigen::Vector3d> LaneTracker::RefitControlPoints(
     const LaneElement& lane, const CameraIntrinsics& camera,
     const Eigen::Isometry3d& T_base_cam) const {
-  const Ipm ipm(PinholeCamera(camera), T_base_cam, options_.ipm.max_range_m);
+  const PinholeCamera pinhole(camera);
   std::vector<Eigen::Vector3d> points;
   for (const LaneMeasurement& m : lane.history) {
-    const Eigen::Isometry3d& T_map_base = store_->frames()[m.frame_index].T_map_base;
+    const FrameRecord& frame = store_->frames()[m.frame_index];
+    const Eigen::Isometry3d& T_map_base = frame.T_map_base;
+    // The ground the front end mapped this frame's pixels onto.
+    const Ipm ipm(pinhole, T_base_cam, options_.ipm.max_range_m, frame.ground_base);
     for (std::size_t i = 0; i < m.points.size(); ++i) {
       Eigen::Vector3d p_base;
       if (m.selected[i] && ipm.PixelToGround(m.points[i].uv, &p_base) == IpmStatus::kOk) {

@@ -13,12 +13,14 @@ MapStore::MapStore(double road_plane_radius_m)
       // Cells of the radius: a query looks at 3x3 cells at most.
       frame_index_(road_plane_radius_m > 0.0 ? road_plane_radius_m : 1.0) {}
 
-const FrameRecord& MapStore::AddFrame(double stamp, const Eigen::Isometry3d& T_map_base_odom) {
+const FrameRecord& MapStore::AddFrame(double stamp, const Eigen::Isometry3d& T_map_base_odom,
+                                      const RoadPlane& ground_base) {
   FrameRecord frame;
   frame.index = map_.frames.size();
   frame.stamp = stamp;
   frame.T_map_base_odom = T_map_base_odom;
   frame.T_map_base = T_map_base_odom;
+  frame.ground_base = ground_base;
   frame_index_.Set(frame.index, frame.T_map_base.translation());
   map_.frames.push_back(frame);
   return map_.frames.back();

@@ -7,6 +7,7 @@
 
 #include "ipm_road_mapper/core/frontend/instance_extraction.h"
 #include "ipm_road_mapper/core/geometry/ipm.h"
+#include "ipm_road_mapper/core/geometry/trajectory_road_plane.h"
 #include "ipm_road_mapper/core/mapper/lane_topology.h"
 #include "ipm_road_mapper/core/mapper/pose_extrapolator.h"
 #include "ipm_road_mapper/core/mapper/timing_series.h"
@@ -19,6 +20,35 @@ namespace {
 MapperOptions WithEffectiveGates(MapperOptions options) {
   options.association = EffectiveAssociationOptions(options);
   return options;
+}
+
+// The front end's ground for a new frame at `T_map_base_odom` (IpmOptions::ground): the road
+// plane of the odometry's recent trajectory (the frames used so far, newest last, then the
+// new frame's), or base_link's plane z = 0.
+RoadPlane FrontEndGround(const IpmOptions& options, const std::vector<FrameRecord>& frames,
+                         double stamp, const Eigen::Isometry3d& T_map_base_odom) {
+  if (options.ground == IpmGround::kBaseLink) return RoadPlane();
+  // The frames within both windows, and one beyond them.
+  std::size_t first = frames.size();
+  double path_m = 0.0;
+  Eigen::Vector3d previous = T_map_base_odom.translation();
+  while (first > 0) {
+    const FrameRecord& frame = frames[first - 1];
+    path_m += (previous - frame.T_map_base_odom.translation()).head<2>().norm();
+    previous = frame.T_map_base_odom.translation();
+    --first;
+    if (path_m > options.road_plane.grade_length_m &&
+        stamp - frame.stamp > options.road_plane.cross_slope_window_s) {
+      break;
+    }
+  }
+  std::vector<StampedPose> recent;
+  recent.reserve(frames.size() - first + 1);
+  for (std::size_t i = first; i < frames.size(); ++i) {
+    recent.push_back({frames[i].stamp, frames[i].T_map_base_odom});
+  }
+  recent.push_back({stamp, T_map_base_odom});
+  return RoadPlaneFromTrajectory(recent, options.road_plane);
 }
 
 }  // namespace
@@ -86,13 +116,18 @@ FrameStatus Mapper::ProcessFrame(const FrameInput& input, std::string* reason) {
         std::chrono::duration<double, std::milli>(Clock::now() - since).count());
   };
   const Clock::time_point start = Clock::now();
-  const Ipm ipm(PinholeCamera(input.camera), windows_.T_base_cam(), options_.ipm.max_range_m);
+  // Pixels go onto the road under and ahead of the vehicle, not onto base_link's plane, which
+  // pitches with the body (trajectory_road_plane.h).
+  const RoadPlane ground_base =
+      FrontEndGround(options_.ipm, store_.frames(), input.stamp, input.T_map_base_odom);
+  const Ipm ipm(PinholeCamera(input.camera), windows_.T_base_cam(), options_.ipm.max_range_m,
+                ground_base);
   FrameObservations observations =
       ExtractObservations(input.mask, classes_, ipm, options_.ipm.error_model, options_.extraction);
   counters_.extraction.Add(observations.counters);
   AppendBounded(&frontend_timing_.extraction_ms, elapsed_ms(start));
 
-  const FrameRecord& frame = store_.AddFrame(input.stamp, input.T_map_base_odom);
+  const FrameRecord& frame = store_.AddFrame(input.stamp, input.T_map_base_odom, ground_base);
   markings_.Update(ipm, frame, &observations.markings);
   lanes_.Update(observations.lanes, frame);
   markings_.DropSpurious(frame.index);

@@ -19,9 +19,21 @@ std::string CheckChordSpacing(const double& v) {
 }
 }  // namespace
 
+const char* ToString(IpmGround ground) {
+  return ground == IpmGround::kBaseLink ? "base_link" : "trajectory";
+}
+
 IpmOptions LoadIpmOptions(OptionsReader reader) {
   IpmOptions o;
   reader.Read<double>("max_range_m", &o.max_range_m, CheckPositive);
+  std::string ground = ToString(o.ground);
+  reader.Read<std::string>("ground", &ground, [](const std::string& v) -> std::string {
+    return v == "trajectory" || v == "base_link" ? "" : "must be trajectory or base_link";
+  });
+  o.ground = ground == "base_link" ? IpmGround::kBaseLink : IpmGround::kTrajectory;
+  reader.Read<double>("road_grade_length_m", &o.road_plane.grade_length_m, CheckPositive);
+  reader.Read<double>("road_cross_slope_window_s", &o.road_plane.cross_slope_window_s,
+                      CheckNonNegative);
   std::vector<double> pixel_error{o.error_model.pixel_error_px.x(),
                                   o.error_model.pixel_error_px.y()};
   reader.Read<std::vector<double>>("pixel_error_px", &pixel_error,
@@ -123,6 +135,9 @@ std::string ToString(const MapperOptions& o) {
     << o.ipm.error_model.pixel_error_px.y() << "]\n"
     << "ipm.pitch_sigma_deg: " << o.ipm.error_model.pitch_sigma_rad / kDegToRad << "\n"
     << "ipm.height_sigma_m: " << o.ipm.error_model.height_sigma_m << "\n"
+    << "ipm.ground: " << ToString(o.ipm.ground) << "\n"
+    << "ipm.road_grade_length_m: " << o.ipm.road_plane.grade_length_m << "\n"
+    << "ipm.road_cross_slope_window_s: " << o.ipm.road_plane.cross_slope_window_s << "\n"
     << "lanes.point_selection: " << (o.lanes.point_selection ? "true" : "false") << "\n"
     << "lanes.selected_points_per_frame: " << o.lanes.selected_points_per_frame << "\n"
     << "lanes.chord_spacing_m: " << o.lanes.fit.chord_spacing_m << "\n"

@@ -225,8 +225,7 @@ void MarkingTracker::CheckConsistency(const Ipm& ipm, const FrameRecord& frame) 
   for (MarkingElement& m : store_->markings()) {
     if (m.confirmed || m.retired) continue;
     const bool seen = m.last_frame == frame.index;
-    Eigen::Vector3d center_base = T_base_map * m.Center();
-    center_base.z() = 0.0;
+    const Eigen::Vector3d center_base = ipm.OnGround((T_base_map * m.Center()).head<2>());
     Eigen::Vector2d uv;
     // Where a view saw it already or nearer, with its center in the image: it should be seen.
     const bool expected = center_base.head<2>().norm() <= m.farthest_view_m &&

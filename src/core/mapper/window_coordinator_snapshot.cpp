@@ -61,7 +61,8 @@ void WindowCoordinator::FinalGlobalSolve(double time_budget_s) {
   }
   for (std::size_t i = start; i < frames.size(); ++i) {
     const FrameRecord& f = frames[i];
-    snapshot.frames.push_back({f.index, f.T_map_base, f.T_map_base_odom, true, f.stamp});
+    snapshot.frames.push_back(
+        {f.index, f.T_map_base, f.T_map_base_odom, true, f.stamp, false, f.ground_base});
   }
   BackendOptions global = o;
   global.rounds = o.final_global_rounds;
@@ -144,11 +145,13 @@ WindowSnapshot WindowCoordinator::BuildSnapshot() {
   }
   for (std::size_t i : context) {
     const FrameRecord& f = frames[i];
-    snapshot.frames.push_back({f.index, f.T_map_base, f.T_map_base_odom, false, f.stamp});
+    snapshot.frames.push_back(
+        {f.index, f.T_map_base, f.T_map_base_odom, false, f.stamp, false, f.ground_base});
   }
   for (std::size_t i = first; i < frames.size(); ++i) {
     const FrameRecord& f = frames[i];
-    snapshot.frames.push_back({f.index, f.T_map_base, f.T_map_base_odom, true, f.stamp});
+    snapshot.frames.push_back(
+        {f.index, f.T_map_base, f.T_map_base_odom, true, f.stamp, false, f.ground_base});
   }
   return snapshot;
 }

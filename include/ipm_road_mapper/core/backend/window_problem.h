@@ -37,6 +37,8 @@ struct WindowFrame {
   // In a result: its pose was free in the last pose step (data moved it); else it is the
   // snapshot's (no measurement in the window touched it).
   bool optimized = false;
+  // The ground the front end mapped this frame's pixels onto, in base_link (FrameRecord).
+  RoadPlane ground_base;
 };
 
 // A marking observed in the window, with its in-window measurements.

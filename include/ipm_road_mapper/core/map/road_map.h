@@ -10,15 +10,18 @@
 #include <vector>
 
 #include "ipm_road_mapper/core/frontend/observations.h"
+#include "ipm_road_mapper/core/geometry/road_surface.h"
 
 namespace ipm_road_mapper {
 
-// One frame the mapper used: its odometry pose and its current (corrected) pose.
+// One frame the mapper used: its odometry pose, its current (corrected) pose and the ground
+// its front end mapped pixels onto.
 struct FrameRecord {
   std::size_t index = 0;  // position in RoadMap::frames
   double stamp = 0.0;
   Eigen::Isometry3d T_map_base_odom = Eigen::Isometry3d::Identity();
   Eigen::Isometry3d T_map_base = Eigen::Isometry3d::Identity();  // corrected estimate
+  RoadPlane ground_base;  // the front end's ground in base_link (trajectory_road_plane.h)
 };
 
 // One observation of a marking, corners already in the element's corner order.

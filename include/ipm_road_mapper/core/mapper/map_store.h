@@ -26,7 +26,8 @@ class MapStore {
 
   // Appends a used frame; its corrected pose starts at the odometry (the front end places
   // its observations there, the pose prior pulls it there).
-  const FrameRecord& AddFrame(double stamp, const Eigen::Isometry3d& T_map_base_odom);
+  const FrameRecord& AddFrame(double stamp, const Eigen::Isometry3d& T_map_base_odom,
+                              const RoadPlane& ground_base = RoadPlane());
   // Sets frame `index`'s corrected pose (a back-end result).
   void SetFramePose(std::size_t index, const Eigen::Isometry3d& T_map_base);
   // Takes the correction fitted over `solved`, the frames a solve just moved

@@ -12,17 +12,29 @@
 #include "ipm_road_mapper/core/geometry/ipm_uncertainty.h"
 #include "ipm_road_mapper/core/geometry/lane_end_fit.h"
 #include "ipm_road_mapper/core/geometry/spline_fitting.h"
+#include "ipm_road_mapper/core/geometry/trajectory_road_plane.h"
 #include "ipm_road_mapper/core/io/yaml_options.h"
 #include "ipm_road_mapper/core/mapper/input_options.h"
 #include "ipm_road_mapper/core/mapper/lane_join.h"
 
 namespace ipm_road_mapper {
 
+// What the front end's IPM maps pixels onto (config key `ipm.ground`).
+enum class IpmGround {
+  kTrajectory,  // the road under and ahead of the vehicle, from its trajectory
+  kBaseLink,    // base_link's plane z = 0 (the paper's flat-ground IPM; pitches with the body)
+};
+
 // IPM and its error model.
 struct IpmOptions {
   double max_range_m = 40.0;  // ground points farther than this are rejected
   IpmErrorModel error_model;  // Omega_p inputs (docs/design.md defaults)
+  IpmGround ground = IpmGround::kBaseLink;
+  TrajectoryRoadPlaneOptions road_plane;  // the trajectory's road plane (ground: trajectory)
 };
+
+// "trajectory" / "base_link".
+const char* ToString(IpmGround ground);
 
 // How lane lines become splines (config section `lanes`).
 struct LaneOptions {
