@@ -28,11 +28,13 @@ MapperOptions WithEffectiveGates(MapperOptions options) {
 RoadPlane FrontEndGround(const IpmOptions& options, const std::vector<FrameRecord>& frames,
                          double stamp, const Eigen::Isometry3d& T_map_base_odom) {
   if (options.ground == IpmGround::kBaseLink) return RoadPlane();
-  // The frames within both windows, and one beyond them.
+  // The frames within both windows, and one beyond them; at most kMaxRecentFrames, so that a
+  // vehicle standing still (no path to cover) costs a bounded scan per frame.
+  constexpr std::size_t kMaxRecentFrames = 600;
   std::size_t first = frames.size();
   double path_m = 0.0;
   Eigen::Vector3d previous = T_map_base_odom.translation();
-  while (first > 0) {
+  while (first > 0 && frames.size() - first < kMaxRecentFrames) {
     const FrameRecord& frame = frames[first - 1];
     path_m += (previous - frame.T_map_base_odom.translation()).head<2>().norm();
     previous = frame.T_map_base_odom.translation();
