@@ -6,7 +6,6 @@
 // which is then joined into the first (its id removed). Every ~vector_map_delta is the same
 // message byte for byte; every ~markers array holds the same markers (DELETEs in any order).
 #include <gtest/gtest.h>
-#include <ros/serialization.h>
 
 #include <algorithm>
 #include <set>
@@ -16,27 +15,12 @@
 #include "ipm_road_mapper/core/mapper/mapper.h"
 #include "ipm_road_mapper/ros/marker_builder.h"
 #include "ipm_road_mapper/ros/vector_map_delta_builder.h"
+#include "ros/message_bytes.h"
 
 namespace ipm_road_mapper {
 namespace {
 
 using namespace test;  // NOLINT: the scene's helpers
-
-template <typename Message>
-std::vector<std::uint8_t> Bytes(const Message& message) {
-  std::vector<std::uint8_t> bytes(ros::serialization::serializationLength(message));
-  ros::serialization::OStream stream(bytes.data(), static_cast<std::uint32_t>(bytes.size()));
-  ros::serialization::serialize(stream, message);
-  return bytes;
-}
-
-// The markers of an array, each serialized, sorted: the array up to its order.
-std::vector<std::vector<std::uint8_t>> MarkerSet(const visualization_msgs::MarkerArray& array) {
-  std::vector<std::vector<std::uint8_t>> set;
-  for (const visualization_msgs::Marker& m : array.markers) set.push_back(Bytes(m));
-  std::sort(set.begin(), set.end());
-  return set;
-}
 
 // Frame k of the script: the vehicle at 0.8 k m along x (its odometry 1.2 m ahead from
 // frame 45 on: duplicates), arrows at 20, 50 and 80 m, a dashed lane at y = 1.8 m with no

@@ -5,7 +5,6 @@
 // whole lane; the messages are those the whole-map way gives; a tail without the context the
 // builders need is refused.
 #include <gtest/gtest.h>
-#include <ros/serialization.h>
 
 #include <algorithm>
 #include <stdexcept>
@@ -14,24 +13,13 @@
 #include "ipm_road_mapper/core/mapper/map_store.h"
 #include "ipm_road_mapper/ros/marker_builder.h"
 #include "ipm_road_mapper/ros/vector_map_delta_builder.h"
+#include "ros/message_bytes.h"
 
 namespace ipm_road_mapper {
 namespace {
 
-template <typename Message>
-std::vector<std::uint8_t> Bytes(const Message& message) {
-  std::vector<std::uint8_t> bytes(ros::serialization::serializationLength(message));
-  ros::serialization::OStream stream(bytes.data(), static_cast<std::uint32_t>(bytes.size()));
-  ros::serialization::serialize(stream, message);
-  return bytes;
-}
-
-std::vector<std::vector<std::uint8_t>> MarkerSet(const visualization_msgs::MarkerArray& array) {
-  std::vector<std::vector<std::uint8_t>> set;
-  for (const visualization_msgs::Marker& m : array.markers) set.push_back(Bytes(m));
-  std::sort(set.begin(), set.end());
-  return set;
-}
+using test::Bytes;
+using test::MarkerSet;
 
 // A straight lane of `points` control points 3 m apart, gently curved in y.
 MapLane Lane(std::size_t points) {
