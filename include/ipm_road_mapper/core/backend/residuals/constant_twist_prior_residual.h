@@ -16,9 +16,10 @@
 #pragma once
 
 #include <ceres/autodiff_cost_function.h>
-#include <ceres/rotation.h>
 
 #include <Eigen/Geometry>
+
+#include "ipm_road_mapper/core/backend/residuals/rotation_vector.h"
 
 namespace ipm_road_mapper {
 namespace residuals {
@@ -59,15 +60,6 @@ class ConstantTwistPriorResidual {
   }
 
  private:
-  template <typename T>
-  static Eigen::Matrix<T, 3, 1> RotationVector(Eigen::Quaternion<T> dq) {
-    if (dq.w() < T(0)) dq.coeffs() = -dq.coeffs();  // the short way round
-    const T wxyz[4] = {dq.w(), dq.x(), dq.y(), dq.z()};
-    Eigen::Matrix<T, 3, 1> angle_axis;
-    ceres::QuaternionToAngleAxis(wxyz, angle_axis.data());
-    return angle_axis;
-  }
-
   double dt_a_, dt_b_;
   Eigen::Vector3d inv_linear_, inv_angular_;
 };
