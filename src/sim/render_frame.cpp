@@ -37,12 +37,18 @@ int PaintGray(PaintColor color) {
 
 bool Overlaps(double a0, double a1, double b0, double b1) { return a0 <= b1 && b0 <= a1; }
 
-// Fills the projection of every occluder box present at (s_cam, t_s) with `value`.
+// Fills the projection of every occluder box present at (s_cam, t_s) with `value`, or, with
+// `instance_class_id` > 0, occluder i with that class's instance value (i + 1).
 void FillOccluders(const std::vector<OccluderOptions>& occluders, const RoadModel& road,
                    const Eigen::Isometry3d& T_cam_map, double s_cam, double t_s,
-                   const FrustumProjector& projector, int value, cv::Mat* image) {
+                   const FrustumProjector& projector, int value, int instance_class_id,
+                   cv::Mat* image) {
   std::vector<Eigen::Vector3d> face_cam;
-  for (const OccluderOptions& occluder : occluders) {
+  for (std::size_t i = 0; i < occluders.size(); ++i) {
+    const OccluderOptions& occluder = occluders[i];
+    if (instance_class_id > 0) {
+      value = instance_class_id * kInstanceIdFactor + static_cast<int>(i) + 1;
+    }
     for (const auto& face_map : OccluderFaces(road, occluder, s_cam, t_s)) {
       face_cam.clear();
       for (const Eigen::Vector3d& p_map : face_map) face_cam.push_back(T_cam_map * p_map);
@@ -125,9 +131,11 @@ void DriveSimulator::RenderMask(const FrameContext& context, bool noise, SimFram
     }
     pending.push_back(p);
   }
-  // Vehicles ahead hide the paint behind them: background in the mask.
+  // Vehicles ahead hide the paint behind them: background in the mask, or their own
+  // instances when the segmentation labels them.
   FillOccluders(scenario_.occluders, world_.road(), context.T_cam_map, context.s_cam,
-                context.index / scenario_.camera.rate_hz, mask_projector_, 0, &frame->mask);
+                context.index / scenario_.camera.rate_hz, mask_projector_, 0, seg.occluder_class_id,
+                &frame->mask);
   for (int b = 0; b < n_blobs; ++b) {
     // A small star-shaped polygon of a random marking class below the image's middle.
     const int class_id = marking_class_ids_[random.UniformInt(0, marking_class_ids_.size() - 1)];
@@ -248,7 +256,8 @@ void DriveSimulator::RenderImage(const FrameContext& context, SimFrame* frame) c
     }
   }
   FillOccluders(scenario_.occluders, road, context.T_cam_map, context.s_cam,
-                context.index / scenario_.camera.rate_hz, image_projector_, kVehicleGray, &image);
+                context.index / scenario_.camera.rate_hz, image_projector_, kVehicleGray, 0,
+                &image);
   // Fixed sensor texture (a repeating tile, so the image still compresses well).
   for (int r = 0; r < image.rows; ++r) {
     std::uint8_t* row = image.ptr<std::uint8_t>(r);

@@ -233,6 +233,11 @@ void ParseSegmentation(OptionsReader r, SegmentationNoiseOptions* o) {
   r.Read<double>("range_m", &o->range_m, CheckPositive);
   r.Read<int>("min_instance_pixels", &o->min_instance_pixels, CheckNonNegativeInt);
   r.Read<double>("split_instance_prob", &o->split_instance_prob, CheckProbability);
+  r.Read<int>("occluder_class_id", &o->occluder_class_id, [](const int& v) -> std::string {
+    return v >= 0 && v <= kMaxClassId
+               ? ""
+               : "must be 0 (background) or a class id in 1.." + std::to_string(kMaxClassId);
+  });
   r.RejectUnknownKeys();
 }
 

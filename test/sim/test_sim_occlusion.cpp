@@ -122,6 +122,36 @@ TEST(SimOccluder, VehicleAheadHidesTheRoadBehindItAndNothingElse) {
   }
 }
 
+// segmentation.occluder_class_id: the same vehicle, drawn as its own instance of that class
+// (as a panoptic network labels vehicles) instead of background; everything else unchanged.
+TEST(SimOccluder, LabelledVehicleIsItsOwnInstanceWhereTheBackgroundVehicleIsZero) {
+  ScenarioOptions scenario = Scenario("public_road");
+  RenderSettings exact;
+  exact.segmentation_noise = false;
+  exact.image = false;
+  OccluderOptions vehicle;
+  vehicle.lane = scenario.vehicle.lane;
+  vehicle.gap_m = 8.0;
+  vehicle.end_s_m = 1000.0;
+  scenario.occluders = {vehicle};
+  DriveSimulator background(scenario, Classes(), 1, 30);
+  scenario.segmentation.occluder_class_id = 30;
+  DriveSimulator labelled(scenario, Classes(), 1, 30);
+  const SimFrame a = background.RenderFrame(20, exact), b = labelled.RenderFrame(20, exact);
+  const cv::Mat vehicle_pixels = b.mask == 30 * kInstanceIdFactor + 1;
+  EXPECT_GT(cv::countNonZero(vehicle_pixels), 500);
+  // Where the labelled vehicle is, the background one left 0; elsewhere both masks agree.
+  EXPECT_EQ(cv::countNonZero(vehicle_pixels & (a.mask != 0)), 0);
+  EXPECT_EQ(cv::countNonZero((a.mask != b.mask) & ~vehicle_pixels), 0);
+  // The vehicle is no mapped element: not among the rendered instances.
+  for (const RenderedInstance& instance : b.instances) {
+    EXPECT_NE(instance.value / kInstanceIdFactor, 30);
+  }
+  EXPECT_NE(ErrorOf(kRoad + "segmentation: {occluder_class_id: 66}")
+                .find("segmentation.occluder_class_id"),
+            std::string::npos);
+}
+
 TEST(SimSplit, SplitPartsAreInstancesOfTheSameElementCountedOnceAsVisible) {
   ScenarioOptions scenario = Scenario("public_road");
   scenario.segmentation.split_instance_prob = 1.0;

@@ -158,10 +158,15 @@ struct SegmentationNoiseOptions {
   // Per frame, each lane or marking instance is cut in two along a random line through its
   // pixel centroid with this probability; the second part gets a fresh instance index.
   double split_instance_prob = 0.0;
+  // The class the segmentation gives the vehicles ahead (OccluderOptions): 0 draws them as
+  // background, as a network that segments road paint only would; 1..65 draws each as an
+  // instance of that class (class_id * 1000 + occluder index + 1), as a panoptic one would.
+  int occluder_class_id = 0;
 };
 
 // A vehicle driving ahead of the ego vehicle; its box hides the road behind it (drawn as
-// background, value 0, in the mask and dark in the image). Its rear is gap(t) = gap_m +
+// background, value 0, in the mask unless segmentation.occluder_class_id is set, and dark in
+// the image). Its rear is gap(t) = gap_m +
 // gap_amplitude_m sin(2 pi t / gap_period_s) ahead of the camera along the road (t from
 // the first frame), on a lane center or a lateral offset, heading along the road.
 struct OccluderOptions {
