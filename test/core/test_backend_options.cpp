@@ -50,6 +50,16 @@ TEST(BackendOptions, BadRobustKernelIsAnOptionsErrorNamingTheKey) {
             0u);
 }
 
+TEST(BackendOptions, JointStepIsOffByDefaultAndValidated) {
+  EXPECT_EQ(LoadFrom("{}").final_global_joint_iterations, 0);
+  EXPECT_EQ(LoadFrom("{final_global_joint_iterations: 50}").final_global_joint_iterations, 50);
+  EXPECT_NE(ToString(LoadFrom("{final_global_joint_iterations: 50}"))
+                .find("backend.final_global_joint_iterations: 50\n"),
+            std::string::npos);
+  EXPECT_EQ(ErrorOf([] { LoadFrom("{final_global_joint_iterations: -1}"); }),
+            "backend.final_global_joint_iterations: must be >= 0");
+}
+
 TEST(BackendOptions, GatesKeepTheirFormerDefaults) {
   const BackendOptions o = LoadFrom("{}");
   EXPECT_EQ(o.max_lane_pixel_distance_m, 1.5);

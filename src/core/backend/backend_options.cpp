@@ -137,6 +137,8 @@ BackendOptions LoadBackendOptions(OptionsReader reader) {
   reader.Read<int>("final_global_rounds", &o.final_global_rounds, CheckPositiveInt);
   reader.Read<int>("final_global_min_measurements_per_marking",
                    &o.final_global_min_measurements_per_marking, CheckPositiveInt);
+  reader.Read<int>("final_global_joint_iterations", &o.final_global_joint_iterations,
+                   [](const int& v) { return v >= 0 ? "" : "must be >= 0"; });
   reader.RejectUnknownKeys();
   return o;
 }
@@ -206,7 +208,8 @@ std::string ToString(const BackendOptions& o) {
     << k << "final_global_rounds: " << o.final_global_rounds << "\n"
     << k
     << "final_global_min_measurements_per_marking: " << o.final_global_min_measurements_per_marking
-    << "\n";
+    << "\n"
+    << k << "final_global_joint_iterations: " << o.final_global_joint_iterations << "\n";
   return s.str();
 }
 

@@ -8,6 +8,7 @@
 
 #include "ipm_road_mapper/core/backend/window_extrinsic.h"
 #include "ipm_road_mapper/core/backend/window_extrinsic_validation.h"
+#include "ipm_road_mapper/core/backend/window_joint_step.h"
 #include "ipm_road_mapper/core/backend/window_map_step.h"
 #include "ipm_road_mapper/core/backend/window_measurements.h"
 #include "ipm_road_mapper/core/backend/window_pose_step.h"
@@ -68,6 +69,22 @@ WindowResult SolveWindow(const WindowSnapshot& snapshot, const BackendOptions& o
       reference.reset();
     }
     if (usable && options.pose_update) run(false);
+  }
+  // The joint step (final global solve, opt-in): down the valley the alternation crawls along.
+  if (snapshot.joint_step_iterations > 0 && usable) {
+    state.step_time_limit_s = remaining_s();
+    if (state.step_time_limit_s > 0.0) {
+      BackendOptions joint = options;
+      joint.max_iterations = snapshot.joint_step_iterations;
+      int blocks = 0;
+      const ceres::Solver::Summary summary = JointStep(snapshot, joint, &state, &blocks);
+      if (blocks > 0) {
+        usable = summary.IsSolutionUsable();
+        result.iterations += static_cast<int>(summary.iterations.size());
+        result.final_cost = summary.final_cost;
+        result.summary = summary.BriefReport();
+      }
+    }
   }
   if (snapshot.cross_validate_extrinsic && options.optimize_extrinsic && usable) {
     result.extrinsic_directions_reverted =

@@ -30,6 +30,7 @@ void WindowCoordinator::FinalGlobalSolve(double time_budget_s) {
   snapshot.newest_pose_covariance = false;  // the windows' covariance stands
   // The drive's calibration: cross-validated, never moved where the data cannot confirm it.
   snapshot.cross_validate_extrinsic = true;
+  snapshot.joint_step_iterations = o.final_global_joint_iterations;
   auto in_span = [start](const auto& measurement) { return measurement.frame_index >= start; };
   std::vector<const MarkingElement*> markings;
   for (const MarkingElement& m : store_->markings()) markings.push_back(&m);

@@ -128,6 +128,10 @@ struct BackendOptions {
   // The global solve samples at least this many measurements per marking (windows use
   // max_measurements_per_marking): it sees each marking's whole history at once.
   int final_global_min_measurements_per_marking = 30;
+  // After its rounds, the global solve's joint step (window_joint_step.h): map, extrinsic
+  // (its lever arm x, y held) and poses free in one problem, at most this many iterations;
+  // 0 = off (docs/backend.md, "The joint step": it trades between drives, opt-in).
+  int final_global_joint_iterations = 0;
 };
 
 // Reads the `backend` section; throws OptionsError naming the bad key.

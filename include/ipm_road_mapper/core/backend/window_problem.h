@@ -85,6 +85,9 @@ struct WindowSnapshot {
   // falls back to the rough one (extrinsic_prior's center) in every direction they do not
   // confirm (window_extrinsic_validation.h; on for the final global solve).
   bool cross_validate_extrinsic = false;
+  // Iterations of the joint step after the rounds (window_joint_step.h; 0: none; the final
+  // global solve's BackendOptions::final_global_joint_iterations).
+  int joint_step_iterations = 0;
 };
 
 // What the optimizer hands back (immutable once published).
