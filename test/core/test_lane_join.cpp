@@ -80,6 +80,14 @@ TEST(LaneJoin, FragmentsOfAnOuterLineStrayingWithThePitchJoin) {
                        period_frames, sigma_m);
     EXPECT_FALSE(LaneContinues(a, beside, LaneJoinOptions(), AssociationOptions())) << y;
   }
+  // Nor when it is seen in only a few frames (noisier still): fewer observations than the
+  // correlation length together know their line no worse than one of them (uncapped, the
+  // line 3.5 m beside passed at cost 2.7).
+  for (const double y : {-1.75, -8.75}) {
+    const LaneElement short_beside = WithPitchStray(
+        MakeLane(4, 1, Straight(y), 46.0, 55.0, 45, 49, &rng), amplitude_m, period_frames, 0.2);
+    EXPECT_FALSE(LaneContinues(a, short_beside, LaneJoinOptions(), AssociationOptions())) << y;
+  }
 }
 
 TEST(LaneJoin, FragmentsOfOneDashedLineAcrossAGapJoin) {

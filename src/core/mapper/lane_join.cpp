@@ -130,15 +130,20 @@ void EndData(const LaneElement& lane, bool at_end, const PairFrame& frame,
       }
       if (kept.empty()) continue;
       ++observations;
-      const double sigma =
-          std::sqrt(floor_sigma_m * floor_sigma_m +
-                    join.ipm_correlation_frames * LateralIpmVariance(*m, kept_index, frame));
+      const double lateral_variance = LateralIpmVariance(*m, kept_index, frame);
       for (const Eigen::Vector3d& p : kept) {
         points->push_back(p);
         weights->push_back(1.0 / static_cast<double>(kept.size()));
-        sigmas->push_back(sigma);
+        sigmas->push_back(lateral_variance);  // made a sigma below
       }
     }
+  }
+  // Fewer observations than the correlation length: together they know the line no worse
+  // than one of them.
+  const double correlated =
+      std::min(join.ipm_correlation_frames, static_cast<double>(observations));
+  for (double& sigma : *sigmas) {
+    sigma = std::sqrt(floor_sigma_m * floor_sigma_m + correlated * sigma);
   }
   if (observations >= 2) return;
   points->clear();
