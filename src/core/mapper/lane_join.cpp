@@ -58,12 +58,45 @@ Eigen::Vector2d EndDirection(const std::vector<Eigen::Vector3d>& cps, bool at_en
   return d.norm() > 1e-9 ? d.normalized() : Eigen::Vector2d::Zero();
 }
 
+// The mean lateral IPM variance (across the pair frame's x axis, Omega_p) of the kept
+// selected points of one measurement (indices into its selected points). Omega_p is in
+// base_link: the frame's yaw (map <- base) is read from the selected points in base_link
+// and in the map. 0 when the measurement carries no points (lanes built without them).
+double LateralIpmVariance(const LaneMeasurement& m, const std::vector<std::size_t>& kept_index,
+                          const PairFrame& frame) {
+  std::vector<std::size_t> sel;
+  for (std::size_t i = 0; i < m.points.size(); ++i) {
+    if (m.selected[i]) sel.push_back(i);
+  }
+  if (sel.size() != m.selected_map.size() || sel.size() < 2 || kept_index.empty()) return 0.0;
+  const Eigen::Vector2d d_base =
+      (m.points[sel.back()].p_base - m.points[sel.front()].p_base).head<2>();
+  const Eigen::Vector2d d_map = (m.selected_map.back() - m.selected_map.front()).head<2>();
+  if (d_base.norm() < 1e-6 || d_map.norm() < 1e-6) return 0.0;
+  const double yaw =
+      std::atan2(d_map.y(), d_map.x()) - std::atan2(d_base.y(), d_base.x());  // map <- base
+  const Eigen::Vector2d normal_map(-frame.x_axis.y(), frame.x_axis.x());
+  const Eigen::Vector2d normal_base(
+      std::cos(yaw) * normal_map.x() + std::sin(yaw) * normal_map.y(),
+      -std::sin(yaw) * normal_map.x() + std::cos(yaw) * normal_map.y());
+  double sum = 0.0;
+  for (std::size_t k : kept_index) {
+    sum += normal_base.dot(m.points[sel[k]].cov_base * normal_base);
+  }
+  return sum / static_cast<double>(kept_index.size());
+}
+
 // The data near one end of `lane` in `frame`, each observation weighted once in total: the
 // selected points of its latest (at_end) or earliest observations within end_length_m of
 // the end's data; the real control points there when fewer than two observations remain
-// (histories are pruned on long drives).
-void EndData(const LaneElement& lane, bool at_end, const PairFrame& frame, double end_length_m,
-             std::vector<Eigen::Vector3d>* points, std::vector<double>* weights) {
+// (histories are pruned on long drives). Each observation's sigma: the floor and its points'
+// lateral Omega_p, the latter times join.ipm_correlation_frames (the body's pitch, most of
+// Omega_p, moves the points of consecutive frames together: docs/backend.md).
+void EndData(const LaneElement& lane, bool at_end, const PairFrame& frame,
+             const LaneJoinOptions& join, double floor_sigma_m,
+             std::vector<Eigen::Vector3d>* points, std::vector<double>* weights,
+             std::vector<double>* sigmas) {
+  const double end_length_m = join.end_length_m;
   const std::vector<Eigen::Vector3d>& cps = lane.control_points_map;
   const Eigen::Vector3d end_cp = at_end ? cps[cps.size() - 2] : cps[1];
   std::vector<const LaneMeasurement*> ms;
@@ -85,35 +118,52 @@ void EndData(const LaneElement& lane, bool at_end, const PairFrame& frame, doubl
   if (std::isfinite(extreme)) {
     for (const LaneMeasurement* m : ms) {
       std::vector<Eigen::Vector3d> kept;
-      for (const Eigen::Vector3d& p : m->selected_map) {
+      std::vector<std::size_t> kept_index;
+      for (std::size_t k = 0; k < m->selected_map.size(); ++k) {
+        const Eigen::Vector3d& p = m->selected_map[k];
         if ((p - end_cp).head<2>().norm() > reach) continue;
         const double x = frame.Local(p).x();
-        if (std::abs(x - extreme) <= end_length_m) kept.push_back(p);
+        if (std::abs(x - extreme) <= end_length_m) {
+          kept.push_back(p);
+          kept_index.push_back(k);
+        }
       }
       if (kept.empty()) continue;
       ++observations;
+      const double lateral_variance = LateralIpmVariance(*m, kept_index, frame);
       for (const Eigen::Vector3d& p : kept) {
         points->push_back(p);
         weights->push_back(1.0 / static_cast<double>(kept.size()));
+        sigmas->push_back(lateral_variance);  // made a sigma below
       }
     }
+  }
+  // Fewer observations than the correlation length: together they know the line no worse
+  // than one of them.
+  const double correlated =
+      std::min(join.ipm_correlation_frames, static_cast<double>(observations));
+  for (double& sigma : *sigmas) {
+    sigma = std::sqrt(floor_sigma_m * floor_sigma_m + correlated * sigma);
   }
   if (observations >= 2) return;
   points->clear();
   weights->clear();
+  sigmas->clear();
   for (std::size_t j = 1; j + 1 < cps.size(); ++j) {
     if ((cps[j] - end_cp).head<2>().norm() <= end_length_m) {
       points->push_back(cps[j]);
       weights->push_back(1.0);
+      sigmas->push_back(floor_sigma_m);
     }
   }
 }
 
-// Weighted least squares of y(x) = a + b x + c x^2 with per-point sigma `sigma_m`; two
-// Huber rounds (scale 2 sigma) so that one stray observation does not bend the end.
+// Weighted least squares of y(x) = a + b x + c x^2 with per-point sigmas; two Huber rounds
+// (scale 2 sigma) so that one stray observation does not bend the end.
 std::optional<EndModel> FitEndModel(const std::vector<Eigen::Vector3d>& points,
-                                    const std::vector<double>& weights, const PairFrame& frame,
-                                    double kappa, double sigma_m) {
+                                    const std::vector<double>& weights,
+                                    const std::vector<double>& sigmas, const PairFrame& frame,
+                                    double kappa) {
   if (points.size() < 2) return std::nullopt;
   EndModel model;
   model.x_min = std::numeric_limits<double>::infinity();
@@ -131,7 +181,7 @@ std::optional<EndModel> FitEndModel(const std::vector<Eigen::Vector3d>& points,
     Eigen::Vector3d b = Eigen::Vector3d::Zero();
     for (std::size_t i = 0; i < xy.size(); ++i) {
       const Eigen::Vector3d row(1.0, xy[i].x(), xy[i].x() * xy[i].x());
-      const double w = weights[i] * robust[i] / (sigma_m * sigma_m);
+      const double w = weights[i] * robust[i] / (sigmas[i] * sigmas[i]);
       N += w * row * row.transpose();
       b += w * row * xy[i].y();
     }
@@ -144,7 +194,7 @@ std::optional<EndModel> FitEndModel(const std::vector<Eigen::Vector3d>& points,
     if (!model.coeff.allFinite()) return std::nullopt;
     for (std::size_t i = 0; i < xy.size(); ++i) {
       const double r = std::abs(model.Offset(xy[i].x()) - xy[i].y());
-      robust[i] = r <= 2.0 * sigma_m ? 1.0 : 2.0 * sigma_m / r;
+      robust[i] = r <= 2.0 * sigmas[i] ? 1.0 : 2.0 * sigmas[i] / r;
     }
   }
   model.cov = N.inverse();
@@ -176,15 +226,15 @@ std::optional<PairAnalysis> Analyze(const LaneElement& first, const LaneElement&
   a.frame.x_axis = (t_first + t_second).normalized();
   const double sigma = LaneFloorSigma(options);
   std::vector<Eigen::Vector3d> points_first, points_second;
-  std::vector<double> weights_first, weights_second;
-  EndData(first, true, a.frame, join.end_length_m, &points_first, &weights_first);
-  EndData(second, false, a.frame, join.end_length_m, &points_second, &weights_second);
+  std::vector<double> weights_first, weights_second, sigmas_first, sigmas_second;
+  EndData(first, true, a.frame, join, sigma, &points_first, &weights_first, &sigmas_first);
+  EndData(second, false, a.frame, join, sigma, &points_second, &weights_second, &sigmas_second);
   const auto model_first =
-      FitEndModel(points_first, weights_first, a.frame,
-                  LaneEndCurvature(first.control_points_map, true, join.end_length_m), sigma);
+      FitEndModel(points_first, weights_first, sigmas_first, a.frame,
+                  LaneEndCurvature(first.control_points_map, true, join.end_length_m));
   const auto model_second =
-      FitEndModel(points_second, weights_second, a.frame,
-                  LaneEndCurvature(second.control_points_map, false, join.end_length_m), sigma);
+      FitEndModel(points_second, weights_second, sigmas_second, a.frame,
+                  LaneEndCurvature(second.control_points_map, false, join.end_length_m));
   if (!model_first || !model_second) return std::nullopt;
   a.first = *model_first;
   a.second = *model_second;

@@ -84,6 +84,8 @@ LaneOptions LoadLaneOptions(OptionsReader reader) {
   reader.Read<double>("join_max_overlap_m", &o.join.max_overlap_m, CheckNonNegative);
   reader.Read<double>("join_end_length_m", &o.join.end_length_m, CheckPositive);
   reader.Read<double>("join_gate_sigmas", &o.join.gate_sigmas, CheckPositive);
+  reader.Read<double>("join_ipm_correlation_frames", &o.join.ipm_correlation_frames,
+                      CheckNonNegative);
   reader.RejectUnknownKeys();
   return o;
 }

@@ -2,7 +2,8 @@
 // continues A. Each end is modelled by the data that shaped it (the selected points of the
 // observations near it, each frame weighted once): a lateral offset y(x) = a + b x + c x^2
 // in a frame along the pair's mean direction, by weighted least squares with a weak
-// curvature prior, and its covariance from the lane noise floor. The two models are
+// curvature prior, and its covariance from the lane noise floor and each observation's
+// lateral IPM uncertainty (Omega_p, correlated over consecutive frames). The two models are
 // compared where the gap is (its middle): the lateral offset and the direction must agree
 // within their combined uncertainty (the extrapolation over the gap is in it), the gap must
 // be short, the class the same, and the two never seen in one frame (two instances of one
@@ -25,6 +26,11 @@ struct LaneJoinOptions {
   double max_overlap_m = 10.0;  // longest stretch where both have data
   double end_length_m = 20.0;   // each end is modelled by its data within this length
   double gate_sigmas = 3.0;     // offset and direction agreement, in combined sigmas
+  // An observation's lateral Omega_p (mostly the body's pitch) enters its end model's sigma
+  // times this: the pitch moves the points of about this many consecutive frames together
+  // (a 1.1 Hz pitch at 20 Hz: a half period is 9 frames), so a model of N frames knows the
+  // line no better than N / this independent frames. 0: the floor sigma alone.
+  double ipm_correlation_frames = 10.0;
 };
 
 // Whether `first`'s end is continued by `second`'s start: the model comparison above. Both
