@@ -181,26 +181,25 @@ def noise_config(args, drive, level):
                       1.5 * level, 1.5 * level, 2.0 * level))
 
 
+def scenario_variant(args, out_root, name, base, overrides):
+    """A drive of scenario `base` with `overrides` (YAML lines) on top, in drives/<name>."""
+    drive = os.path.join(out_root, "drives", name)
+    os.makedirs(drive, exist_ok=True)
+    scenario = overlay(os.path.join(drive, "scenario.yaml"), "base: %s\nname: %s\n%s\n" % (
+        os.path.join(args.repo, "config", "scenarios", base + ".yaml"), name, overrides))
+    return drive, scenario
+
+
 def blob_drive(args, out_root):
     """public_road with one spurious segmentation blob per frame (issue 11)."""
-    drive = os.path.join(out_root, "drives", BLOBS)
-    os.makedirs(drive, exist_ok=True)
-    scenario = overlay(os.path.join(drive, "scenario.yaml"),
-                       "base: %s\nname: %s\nsegmentation: {spurious_blobs_per_frame: 1.0}\n"
-                       % (os.path.join(args.repo, "config", "scenarios", "public_road.yaml"),
-                          BLOBS))
-    return drive, scenario
+    return scenario_variant(args, out_root, BLOBS, "public_road",
+                            "segmentation: {spurious_blobs_per_frame: 1.0}")
 
 
 def urban_labelled_drive(args, out_root):
     """urban with its vehicles ahead drawn as instances of class 30 instead of background."""
-    drive = os.path.join(out_root, "drives", URBAN_LABELLED)
-    os.makedirs(drive, exist_ok=True)
-    scenario = overlay(os.path.join(drive, "scenario.yaml"),
-                       "base: %s\nname: %s\nsegmentation: {occluder_class_id: 30}\n"
-                       % (os.path.join(args.repo, "config", "scenarios", "urban.yaml"),
-                          URBAN_LABELLED))
-    return drive, scenario
+    return scenario_variant(args, out_root, URBAN_LABELLED, "urban",
+                            "segmentation: {occluder_class_id: 30}")
 
 
 def main():

@@ -2,7 +2,6 @@
 
 #include "ipm_road_mapper/core/backend/residuals/corner_reprojection_residual.h"
 #include "ipm_road_mapper/core/backend/residuals/edge_reprojection_residual.h"
-#include "ipm_road_mapper/core/backend/residuals/extrinsic_prior_residual.h"
 #include "ipm_road_mapper/core/backend/residuals/pose_uncertainty.h"
 #include "ipm_road_mapper/core/backend/residuals/ppsr_residual.h"
 #include "ipm_road_mapper/core/backend/window_map_step.h"
@@ -93,19 +92,11 @@ ceres::Solver::Summary JointStep(const WindowSnapshot& snapshot, const BackendOp
     return ceres::Solver::Summary();
   }
   AddMapPointPriors(options, state, &problem);
-  if (problem.HasParameterBlock(q_bc)) {
-    problem.AddResidualBlock(residuals::ExtrinsicPriorResidual::Create(snapshot.extrinsic_prior),
-                             nullptr, q_bc, t_bc);
-    problem.SetManifold(q_bc, new ceres::EigenQuaternionManifold);
-    if (!options.optimize_extrinsic || state->extrinsic_frozen) {
-      problem.SetParameterBlockConstant(q_bc);
-      problem.SetParameterBlockConstant(t_bc);
-    } else {
-      // The lever arm x, y: with the poses free, a shift of the camera and of every pose
-      // explains the data alike (docs/backend.md, "What is observable"); free here it moved
-      // 6-12 cm the wrong way on curvy and port seeds 2-3 (and the halves then agreed).
-      problem.SetManifold(t_bc, new ceres::SubsetManifold(3, {0, 1}));
-    }
+  if (AddExtrinsicPrior(snapshot, options, state, &problem)) {
+    // The lever arm x, y: with the poses free, a shift of the camera and of every pose
+    // explains the data alike (docs/backend.md, "What is observable"); free here it moved
+    // 6-12 cm the wrong way on curvy and port seeds 2-3 (and the halves then agreed).
+    problem.SetManifold(t_bc, new ceres::SubsetManifold(3, {0, 1}));
   }
   AddMotionPriors(snapshot, options, MotionPriorTriples::kMiddleInProblem, state, &problem);
   AddPosePriors(snapshot, options, state, &problem);

@@ -196,8 +196,6 @@ ceres::Solver::Summary MapStep(const WindowSnapshot& snapshot, const BackendOpti
                                WindowState* state, int* blocks) {
   ceres::Problem problem;
   ceres::LossFunction* loss = MakeLoss(options);
-  double* q_bc = state->extrinsic.q;
-  double* t_bc = state->extrinsic.t;
   *blocks = AddMapStepMeasurements(snapshot, options,
                                    state->hold_out ? Measurements::kTraining : Measurements::kAll,
                                    loss, state, &problem);
@@ -206,21 +204,27 @@ ceres::Solver::Summary MapStep(const WindowSnapshot& snapshot, const BackendOpti
     return ceres::Solver::Summary();
   }
   AddMapPointPriors(options, state, &problem);
-  // The extrinsic: the prior of the retired data and the mounting (counted there once),
-  // rotation on the quaternion manifold; held when not optimized, and in the directions the
-  // data does not observe.
-  if (problem.HasParameterBlock(q_bc)) {
-    problem.AddResidualBlock(residuals::ExtrinsicPriorResidual::Create(snapshot.extrinsic_prior),
-                             nullptr, q_bc, t_bc);
-    problem.SetManifold(q_bc, new ceres::EigenQuaternionManifold);
-    if (!options.optimize_extrinsic || state->extrinsic_frozen) {
-      problem.SetParameterBlockConstant(q_bc);
-      problem.SetParameterBlockConstant(t_bc);
-    } else {
-      HoldUnobservedDirections(snapshot, options, *state, &problem);
-    }
+  // The extrinsic, held also in the directions the data does not observe.
+  if (AddExtrinsicPrior(snapshot, options, state, &problem)) {
+    HoldUnobservedDirections(snapshot, options, *state, &problem);
   }
   return Solve(options, state->step_time_limit_s, &problem);
+}
+
+bool AddExtrinsicPrior(const WindowSnapshot& snapshot, const BackendOptions& options,
+                       WindowState* state, ceres::Problem* problem) {
+  double* q_bc = state->extrinsic.q;
+  double* t_bc = state->extrinsic.t;
+  if (!problem->HasParameterBlock(q_bc)) return false;
+  problem->AddResidualBlock(residuals::ExtrinsicPriorResidual::Create(snapshot.extrinsic_prior),
+                            nullptr, q_bc, t_bc);
+  problem->SetManifold(q_bc, new ceres::EigenQuaternionManifold);
+  if (!options.optimize_extrinsic || state->extrinsic_frozen) {
+    problem->SetParameterBlockConstant(q_bc);
+    problem->SetParameterBlockConstant(t_bc);
+    return false;
+  }
+  return true;
 }
 
 std::vector<double> HeldOutCosts(const WindowSnapshot& snapshot, const BackendOptions& options,

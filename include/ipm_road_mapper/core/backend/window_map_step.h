@@ -16,6 +16,13 @@ namespace window_solve {
 void AddMapPointPriors(const BackendOptions& options, WindowState* state,
                        ceres::Problem* problem_ptr);
 
+// The extrinsic's blocks, when the problem has them: the prior of the retired data and the
+// mounting (counted there once), the rotation on the quaternion manifold, both held when the
+// extrinsic is not optimized or frozen. Returns whether it is free (the caller then holds
+// what its step cannot observe).
+bool AddExtrinsicPrior(const WindowSnapshot& snapshot, const BackendOptions& options,
+                       WindowState* state, ceres::Problem* problem);
+
 // Which of a state's measurements a problem gets.
 enum class Measurements { kTraining, kHeldOut, kAll };
 
