@@ -3,6 +3,7 @@
 //   rosrun ipm_road_mapper map_from_bag --bag <bag> [--config <yaml>] [--classes <yaml>]
 //                                       [--async] --out <dir> [--stats-out <csv>]
 //                                       [--publish-stats-out <csv>]
+//                                       [--callgrind-spans <t0:t1,...>]
 //
 // The back end solves every window in turn (backend.synchronous forced on: offline the bag
 // is read far faster than real time, and an owned optimizer thread would drop most
@@ -16,7 +17,9 @@
 // uses), runs the core Mapper, and writes <dir>/map.json, <dir>/map.geojson,
 // <dir>/map_trajectory_tum.txt and <dir>/summary.txt (with startup_s: process start to the first
 // frame mapped), with --stats-out a CSV row per frame (CPU time, RSS), and with
-// --publish-stats-out the publication's CPU per publish near each km (PublishCostProbe). The rough
+// --publish-stats-out the publication's CPU per publish near each km (PublishCostProbe); under
+// valgrind, --callgrind-spans counts the instructions of chosen spans of frames
+// (InstructionSpans, scripts/benchmark.sh --long --instructions). The rough
 // extrinsic T_base_cam is the config's input.extrinsic when given, else the bag's /tf_static
 // transform from input.base_frame to the mask's header.frame_id (a chain of static transforms
 // is composed). Defaults: --config and --classes are config/mapper.yaml and
@@ -51,6 +54,7 @@
 #include "ipm_road_mapper/pipeline/command_line.h"
 #include "ipm_road_mapper/pipeline/extrinsic_source.h"
 #include "ipm_road_mapper/pipeline/frame_assembler.h"
+#include "ipm_road_mapper/pipeline/instruction_spans.h"
 #include "ipm_road_mapper/pipeline/map_files.h"
 #include "ipm_road_mapper/pipeline/mapper_config.h"
 #include "ipm_road_mapper/pipeline/mapping_session.h"
@@ -78,6 +82,7 @@ struct Arguments {
   std::string stats_out;          // empty: no per-frame stats file
   std::string publish_stats_out;  // empty: no publish-cost CSV
   std::string calibration_out;    // empty: no calibration file
+  std::string callgrind_spans;    // empty: no instruction counting
   bool async = false;             // keep backend.synchronous as configured (live-like timing)
 };
 
@@ -112,7 +117,11 @@ std::optional<int> ParseArguments(int argc, char** argv, Arguments* args) {
                 "the incremental export and the old whole-map way (docs/map_from_bag.md)")
       .Optional("calibration-out", "<file.yaml>", &args->calibration_out, "none",
                 "the refined extrinsic as a config whose input.extrinsic the next run reads, "
-                "with a static_transform_publisher line and a URDF joint (docs/map_from_bag.md)");
+                "with a static_transform_publisher line and a URDF joint (docs/map_from_bag.md)")
+      .Optional("callgrind-spans", "<t0:t1,...>", &args->callgrind_spans, "none",
+                "under valgrind --tool=callgrind --instr-atstart=no: count the instructions of "
+                "the frames in these stamp spans, one callgrind dump per span "
+                "(pipeline/instruction_spans.h)");
   return line.ParseOrExitCode(argc, argv);
 }
 
@@ -215,6 +224,21 @@ int Run(int argc, char** argv) {
     publish_probe.emplace(args.publish_stats_out, config.ros.publish_rate_hz);
   }
 
+  std::optional<InstructionSpans> instruction_spans;
+  if (!args.callgrind_spans.empty()) {
+    std::vector<StampSpan> spans;
+    try {
+      spans = ParseStampSpans(args.callgrind_spans);
+    } catch (const std::invalid_argument& e) {
+      throw InputError(std::string("--callgrind-spans: ") + e.what());
+    }
+    InstructionCounterHooks hooks;
+    if (const std::string reason = CallgrindHooks(&hooks); !reason.empty()) {
+      throw InputError("--callgrind-spans: " + reason);
+    }
+    instruction_spans.emplace(std::move(spans), std::move(hooks));
+  }
+
   // The same pipeline as the nodelet's; no odometry wait rule offline (the bag is complete).
   MappingSession session(options, classes);
   session.Start(T_base_cam);
@@ -231,6 +255,7 @@ int Run(int argc, char** argv) {
   BagMappingCallbacks callbacks;
   callbacks.frame_done = [&](std::size_t frame, double stamp) {
     if (frame_stats) frame_stats->Add(frame, stamp);
+    if (instruction_spans) instruction_spans->OnFrameDone(stamp);
     if (publish_probe) publish_probe->OnFrame(*session.mapper(), frame, stamp);
     progress.Update(frame + 1);
   };
@@ -240,6 +265,11 @@ int Run(int argc, char** argv) {
   };
   BagMappingResult read = MapBag(bag, topics, &session, callbacks);
   progress.Finish();
+  if (instruction_spans) {
+    instruction_spans->Finish();
+    std::cerr << "map_from_bag: instruction counts of " << instruction_spans->dumped()
+              << " spans dumped (" << instruction_spans->skipped() << " held no frame)\n";
+  }
   stats.frames_read = read.frames_read;
   stats.lost = std::move(read.lost);
   stats.bag_begin_s = rosbag::View(bag).getBeginTime().toSec();
