@@ -74,7 +74,8 @@ std::string CalibrationLine(const Mapper& mapper) {
     << " " << sigma(4) << " " << sigma(5)
     << " m; observed: " << ObservedAxesText(mapper.extrinsic_observed())
     << "; extrinsic updates rejected " << mapper.counters().extrinsic_rejected
-    << " (held-out frames explained worse)";
+    << " (held-out frames explained worse); joint step held "
+    << mapper.counters().joint_extrinsic_held << " unobserved directions";
   return s.str();
 }
 

@@ -9,8 +9,40 @@
 namespace ipm_road_mapper {
 namespace window_solve {
 
+namespace {
+
+// The joint problem's residual blocks that are the extrinsic prior (AddExtrinsicPrior): the
+// only ones on the extrinsic's two blocks alone (a hold added later would be too).
+std::vector<ceres::ResidualBlockId> ExtrinsicPriorBlocks(ceres::Problem* problem, double* q_bc,
+                                                         double* t_bc) {
+  std::vector<ceres::ResidualBlockId> on_q, prior;
+  problem->GetResidualBlocksForParameterBlock(q_bc, &on_q);
+  for (ceres::ResidualBlockId id : on_q) {
+    std::vector<double*> blocks;
+    problem->GetParameterBlocksForResidualBlock(id, &blocks);
+    if (blocks.size() == 2 && blocks[0] == q_bc && blocks[1] == t_bc) prior.push_back(id);
+  }
+  return prior;
+}
+
+}  // namespace
+
+ExtrinsicObservability JointObservability(const Matrix6d& information,
+                                          const BackendOptions& options) {
+  Matrix6d held_lever_arm = information;
+  held_lever_arm.row(3).setZero();
+  held_lever_arm.row(4).setZero();
+  held_lever_arm.col(3).setZero();
+  held_lever_arm.col(4).setZero();
+  return AnalyzeObservability(
+      held_lever_arm,
+      PriorSigma(options.rotation_prior_sigma_rad, options.translation_prior_sigma_m),
+      options.extrinsic_min_information_ratio);
+}
+
 ceres::Solver::Summary JointStep(const WindowSnapshot& snapshot, const BackendOptions& options,
-                                 WindowState* state, int* blocks) {
+                                 WindowState* state, int* blocks,
+                                 std::optional<ExtrinsicObservability>* observability) {
   ceres::Problem problem;
   ceres::LossFunction* loss = MakeLoss(options);
   const PinholeCamera camera(snapshot.camera);
@@ -92,12 +124,7 @@ ceres::Solver::Summary JointStep(const WindowSnapshot& snapshot, const BackendOp
     return ceres::Solver::Summary();
   }
   AddMapPointPriors(options, state, &problem);
-  if (AddExtrinsicPrior(snapshot, options, state, &problem)) {
-    // The lever arm x, y: with the poses free, a shift of the camera and of every pose
-    // explains the data alike (docs/backend.md, "What is observable"); free here it moved
-    // 6-12 cm the wrong way on curvy and port seeds 2-3 (and the halves then agreed).
-    problem.SetManifold(t_bc, new ceres::SubsetManifold(3, {0, 1}));
-  }
+  const bool extrinsic_free = AddExtrinsicPrior(snapshot, options, state, &problem);
   AddMotionPriors(snapshot, options, MotionPriorTriples::kMiddleInProblem, state, &problem);
   AddPosePriors(snapshot, options, state, &problem);
   if (!options.pose_update) {
@@ -106,6 +133,20 @@ ceres::Solver::Summary JointStep(const WindowSnapshot& snapshot, const BackendOp
       problem.SetParameterBlockConstant(pose.q);
       problem.SetParameterBlockConstant(pose.t);
     }
+  }
+  if (extrinsic_free) {
+    // What this problem's data (everything but the extrinsic prior) observes of the
+    // extrinsic, the map and the poses marginalized, with the lever arm held; the directions
+    // it does not observe stay where the alternation left them.
+    const ExtrinsicObservability joint = JointObservability(
+        ExtrinsicInformation(&problem, q_bc, t_bc, ExtrinsicPriorBlocks(&problem, q_bc, t_bc)),
+        options);
+    HoldUnobservedDirections(joint, T_base_cam, state, &problem);
+    if (observability != nullptr) *observability = joint;
+    // The lever arm x, y: with the poses free, a shift of the camera and of every pose
+    // explains the data alike (docs/backend.md, "What is observable"); free here it moved
+    // 6-12 cm the wrong way on curvy and port seeds 2-3 (and the halves then agreed).
+    problem.SetManifold(t_bc, new ceres::SubsetManifold(3, {0, 1}));
   }
   return Solve(options, state->step_time_limit_s, &problem);
 }

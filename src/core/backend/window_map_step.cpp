@@ -36,26 +36,19 @@ void ConfigurePoint(const BackendOptions& options, double* point, ceres::Problem
   if (!options.optimize_z) problem->SetManifold(point, new ceres::SubsetManifold(3, {2}));
 }
 
-// Weight of the hold on an unobserved direction, in whitened units (times the mounting
-// prior's information): the direction stays within 1 % of a prior sigma of its start value.
-constexpr double kUnobservedHoldWeight = 1e4;
+}  // namespace
 
-// The observability-aware update (extrinsic_observability.h): each direction the solve's
-// data does not observe (ObserveExtrinsic) is held at the window's starting extrinsic.
-void HoldUnobservedDirections(const WindowSnapshot& snapshot, const BackendOptions& options,
-                              const WindowState& state, ceres::Problem* problem) {
-  if (!options.extrinsic_hold_unobserved) return;
-  if (!state.observability_valid || state.observability.rank == 6) return;
-  const Eigen::Quaterniond q0 = Eigen::Quaterniond(snapshot.T_base_cam.linear()).normalized();
+void HoldUnobservedDirections(const ExtrinsicObservability& observability,
+                              const Eigen::Isometry3d& T_base_cam_start, WindowState* state,
+                              ceres::Problem* problem) {
+  if (observability.rank == 6) return;
+  const Eigen::Quaterniond q0 = Eigen::Quaterniond(T_base_cam_start.linear()).normalized();
   problem->AddResidualBlock(
       residuals::ExtrinsicPriorResidual::Create(
-          q0, snapshot.T_base_cam.translation(),
-          state.observability.UnobservedHoldSqrtInformation(kUnobservedHoldWeight),
-          Vector6d::Zero()),
-      nullptr, const_cast<double*>(state.extrinsic.q), const_cast<double*>(state.extrinsic.t));
+          q0, T_base_cam_start.translation(),
+          observability.UnobservedHoldSqrtInformation(kUnobservedHoldWeight), Vector6d::Zero()),
+      nullptr, state->extrinsic.q, state->extrinsic.t);
 }
-
-}  // namespace
 
 void AddMapPointPriors(const BackendOptions& options, WindowState* state,
                        ceres::Problem* problem_ptr) {
@@ -205,8 +198,9 @@ ceres::Solver::Summary MapStep(const WindowSnapshot& snapshot, const BackendOpti
   }
   AddMapPointPriors(options, state, &problem);
   // The extrinsic, held also in the directions the data does not observe.
-  if (AddExtrinsicPrior(snapshot, options, state, &problem)) {
-    HoldUnobservedDirections(snapshot, options, *state, &problem);
+  if (AddExtrinsicPrior(snapshot, options, state, &problem) && options.extrinsic_hold_unobserved &&
+      state->observability_valid) {
+    HoldUnobservedDirections(state->observability, snapshot.T_base_cam, state, &problem);
   }
   return Solve(options, state->step_time_limit_s, &problem);
 }

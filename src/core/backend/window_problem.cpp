@@ -77,7 +77,10 @@ WindowResult SolveWindow(const WindowSnapshot& snapshot, const BackendOptions& o
       BackendOptions joint = options;
       joint.max_iterations = snapshot.joint_step_iterations;
       int blocks = 0;
-      const ceres::Solver::Summary summary = JointStep(snapshot, joint, &state, &blocks);
+      std::optional<ExtrinsicObservability> observed;
+      const ceres::Solver::Summary summary = JointStep(snapshot, joint, &state, &blocks, &observed);
+      // Of the four directions free in it (the lever arm x, y is held), those not observed.
+      if (observed) result.joint_extrinsic_held = std::max(0, 4 - observed->rank);
       if (blocks > 0) {
         usable = summary.IsSolutionUsable();
         result.iterations += static_cast<int>(summary.iterations.size());

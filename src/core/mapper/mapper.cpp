@@ -267,6 +267,7 @@ void Mapper::ExportHeader(std::size_t max_poses, SnapshotCache* cache, VectorMap
   metadata["backend_results_applied"] = counters_.results_applied;
   metadata["backend_results_rejected"] = counters_.results_rejected;
   metadata["backend_extrinsic_rejected"] = counters_.extrinsic_rejected;
+  metadata["backend_joint_extrinsic_held"] = counters_.joint_extrinsic_held;
   const std::vector<float>& total_ms = frontend_timing_.total_ms;
   const std::vector<float>& extraction_ms = frontend_timing_.extraction_ms;
   metadata["frontend_time_p50_ms"] =

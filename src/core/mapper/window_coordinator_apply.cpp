@@ -27,6 +27,7 @@ void WindowCoordinator::ApplyResult(const WindowResult& result, bool include_ret
     ++counters_->extrinsic_rejected;  // T_base_cam is the previous one; so is what is known
   } else {
     counters_->extrinsic_rejected += result.extrinsic_directions_reverted > 0 ? 1 : 0;
+    counters_->joint_extrinsic_held += static_cast<std::uint64_t>(result.joint_extrinsic_held);
     extrinsic_covariance_ = result.T_base_cam_covariance;
     for (int i = 0; i < 6; ++i) observed_[i] = observed_[i] || result.extrinsic_observed[i];
   }

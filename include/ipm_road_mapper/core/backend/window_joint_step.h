@@ -4,6 +4,8 @@
 
 #include <ceres/ceres.h>
 
+#include <optional>
+
 #include "ipm_road_mapper/core/backend/window_state.h"
 
 namespace ipm_road_mapper {
@@ -19,8 +21,22 @@ namespace window_solve {
 // Why: the alternation of the two steps moves along the valley where camera and vehicle motion
 // trade against each other by a few thousandths of a degree per round (public_road: 0.004 ->
 // 0.0013 deg per round over 12 rounds, not converged); the joint step goes down it at once.
+// Observability-aware (extrinsic_observability.h, Schneider et al. RA-L 2019): the joint
+// problem's own information on the extrinsic (every residual but the extrinsic prior, the map
+// points and poses marginalized at the values before the step), with the lever arm held, is
+// compared with the mounting prior; each direction it does not observe
+// (extrinsic_min_information_ratio) is held at the extrinsic before the step, and only the
+// observed ones move. `observability` (optional) receives that analysis when the extrinsic
+// is free in the step.
 ceres::Solver::Summary JointStep(const WindowSnapshot& snapshot, const BackendOptions& options,
-                                 WindowState* state, int* blocks);
+                                 WindowState* state, int* blocks,
+                                 std::optional<ExtrinsicObservability>* observability = nullptr);
+
+// The analysis of the joint step's information (chart, extrinsic_observability.h) with the
+// lever arm (x, y) held: its rows and columns dropped, so x and y come out unobserved and
+// every other direction is judged by what the data says with the lever arm known.
+ExtrinsicObservability JointObservability(const Matrix6d& information,
+                                          const BackendOptions& options);
 
 }  // namespace window_solve
 }  // namespace ipm_road_mapper

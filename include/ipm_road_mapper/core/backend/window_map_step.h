@@ -23,6 +23,19 @@ void AddMapPointPriors(const BackendOptions& options, WindowState* state,
 bool AddExtrinsicPrior(const WindowSnapshot& snapshot, const BackendOptions& options,
                        WindowState* state, ceres::Problem* problem);
 
+// Weight of the hold on an unobserved direction, in whitened units (times the mounting
+// prior's information): the direction stays within 1 % of a prior sigma of its start value.
+constexpr double kUnobservedHoldWeight = 1e4;
+
+// The observability-aware update (extrinsic_observability.h): every direction that
+// `observability` does not observe is held at T_base_cam_start (a stiff ExtrinsicPriorResidual
+// on the state's extrinsic); the observed ones move. The map step holds what its solve's data
+// does not observe at the solve's start (extrinsic_hold_unobserved), the joint step what the
+// joint problem does not observe at the extrinsic before it.
+void HoldUnobservedDirections(const ExtrinsicObservability& observability,
+                              const Eigen::Isometry3d& T_base_cam_start, WindowState* state,
+                              ceres::Problem* problem);
+
 // Which of a state's measurements a problem gets.
 enum class Measurements { kTraining, kHeldOut, kAll };
 

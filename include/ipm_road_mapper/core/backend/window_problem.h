@@ -115,6 +115,9 @@ struct WindowResult {
   // The cross-validation: how many observed directions of the extrinsic it sent back to
   // the rough value (the halves of the data disagreed on them).
   int extrinsic_directions_reverted = 0;
+  // The joint step (window_joint_step.h): how many directions of the extrinsic besides the
+  // held lever arm its data did not observe, held where the alternation left them.
+  int joint_extrinsic_held = 0;
   double solve_time_s = 0.0;
   int residual_blocks = 0;
   int iterations = 0;

@@ -37,6 +37,9 @@ struct MapperCounters {
   // Applied results whose refined extrinsic the guard refused (it explained the held-out
   // frames worse than the previous one, which was kept; window_problem.h).
   std::uint64_t extrinsic_rejected = 0;
+  // Directions of the extrinsic the final global solve's joint step held because its data
+  // did not observe them (window_problem.h, WindowResult::joint_extrinsic_held).
+  std::uint64_t joint_extrinsic_held = 0;
   std::uint64_t SkippedTotal() const;
 };
 
