@@ -217,9 +217,14 @@ def main():
     parser.add_argument("--out", default=None)
     parser.add_argument("--long", action="store_true",
                         help="the long-drive benchmark only (10 km, scripts/benchmark_long.py)")
+    parser.add_argument("--instructions", action="store_true",
+                        help="with --long: also count instructions per frame of three copies of "
+                             "the route under callgrind (about 30 min more)")
     args = parser.parse_args()
     args.shared = args.shared or os.path.join(args.repo, "..", "shared")
     out_root = args.out or os.path.join(args.repo, "out", "benchmark")
+    if args.instructions and not args.long:
+        parser.error("--instructions goes with --long")
     if args.long:
         import benchmark_long
         return benchmark_long.main(args, out_root)

@@ -5,6 +5,7 @@
 #   bash scripts/benchmark.sh [--scenarios public_road,port,hilly,urban,curvy,av2_pit_dev]
 #                             [--quick] [--jobs 2] [--shared <dir>]
 #   bash scripts/benchmark.sh --long     # the 10 km long-drive benchmark alone (docs/benchmark.md)
+#   bash scripts/benchmark.sh --long --instructions   # and instructions per frame (callgrind)
 set -eo pipefail
 repo="$(cd "$(dirname "${BASH_SOURCE[0]}")/.." && pwd)"
 build="${IRM_BUILD_DIR:-$repo/.build}"

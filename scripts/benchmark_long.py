@@ -16,11 +16,13 @@ changed built, the rest shared), beside the snapshot as it was (ExportMap withou
 topology, every element copied), and the publish's and ExportChanges' median per km. Figures are measured and printed; nothing
 is asserted.
 """
+import bisect
 import csv
 import json
 import os
 import re
 import resource
+import shutil
 import subprocess
 import sys
 import time
@@ -34,6 +36,10 @@ PUBLISH_HEADER = ["km", "frame", "stamp", "markings", "lanes", "changed_elements
                   "export_changes_ms", "export_snapshot_ms", "publish_ms", "publish_old_ms",
                   "export_snapshot_old_ms"]
 PUBLISH_KMS = (1, 3, 10)
+# --instructions: the copies of public_road (0-based, of repeat_count) whose frames callgrind
+# counts: one in the first tenth of the drive (not the first copy: its start-up), one in the
+# middle, the second-last (the last tenth; the last copy holds the end-of-drive work).
+INSTRUCTION_COPIES = (1, 16, 31)
 TENTHS = 10
 SIXTHS = 6
 
@@ -219,6 +225,83 @@ def evaluate_sixths(args, split, out):
     return rows
 
 
+def repeat_count(args):
+    """The long scenario's repeat_count (copies of public_road's route)."""
+    text = open(os.path.join(args.repo, "config", "scenarios", SCENARIO + ".yaml")).read()
+    match = re.search(r"^repeat_count:\s*(\d+)", text, re.M)
+    if not match:
+        sys.exit("benchmark --long: %s.yaml has no repeat_count" % SCENARIO)
+    return int(match.group(1))
+
+
+def copy_spans(index, copies, count):
+    """Stamp spans "t0:t1" of whole copies of the route, by distance driven: copy k is the
+    distance range [k, k + 1) * total / count; t0 and t1 are the stamps of the first frames
+    at or past its two ends (map_from_bag counts the frames after t0 up to t1)."""
+    spans = []
+    for k in copies:
+        ends = [min(len(index.stamps) - 1, bisect.bisect_left(index.distance_m, d))
+                for d in (k * index.total_m / count, (k + 1) * index.total_m / count)]
+        spans.append("%.6f:%.6f" % (index.stamps[ends[0]], index.stamps[ends[1]]))
+    return spans
+
+
+def read_callgrind_dumps(folder):
+    """(span, frames, instructions) of each callgrind dump map_from_bag --callgrind-spans
+    wrote: its `desc: Trigger: Client Request: span <k> frames <n> ...` line and its
+    `totals:` line (instructions, Ir: the sum of the dump's cost lines; its `summary:` line is
+    not used, callgrind derives it by subtraction, which CALLGRIND_ZERO_STATS upsets), sorted
+    by span."""
+    result = []
+    for name in sorted(os.listdir(folder)):
+        if not name.startswith("callgrind.out"):
+            continue
+        text = open(os.path.join(folder, name), errors="replace").read()
+        trigger = re.search(r"^desc: Trigger: Client Request: span (\d+) frames (\d+)", text, re.M)
+        total = re.search(r"^totals:\s*(\d+)", text, re.M)
+        if trigger and total:
+            result.append((int(trigger.group(1)), int(trigger.group(2)), int(total.group(1))))
+    return sorted(result)
+
+
+def instruction_rows(args, drive, out_root):
+    """Instructions per frame of INSTRUCTION_COPIES, counted by callgrind (map_from_bag
+    --callgrind-spans under valgrind --tool=callgrind --instr-atstart=no): a cost figure the
+    machine's load does not move, beside the CPU seconds per tenth. Table rows."""
+    if not shutil.which("valgrind"):
+        sys.exit("benchmark --long --instructions: valgrind is not installed "
+                 "(apt-get install valgrind; scripts/setup.sh installs it)")
+    out = os.path.join(out_root, "maps", SCENARIO, "callgrind")
+    shutil.rmtree(out, ignore_errors=True)
+    os.makedirs(out)
+    gt = json.load(open(os.path.join(drive, "ground_truth.json")))
+    index = long_drive_split.DriveIndex(gt["frames"])
+    count = repeat_count(args)
+    spans = copy_spans(index, INSTRUCTION_COPIES, count)
+    print("[benchmark] %s: counting instructions of copies %s under callgrind (about 30 min)"
+          % (SCENARIO, ", ".join(str(k + 1) for k in INSTRUCTION_COPIES)), file=sys.stderr)
+    wall, _ = timed(lambda: benchmark.run(
+        ["valgrind", "--tool=callgrind", "--instr-atstart=no",
+         "--callgrind-out-file=" + os.path.join(out, "callgrind.out.%p"),
+         os.path.join(args.bin, "map_from_bag"), "--bag", os.path.join(drive, "drive.bag"),
+         "--config", os.path.join(args.repo, "config", "mapper.yaml"), "--out", out,
+         "--callgrind-spans", ",".join(spans)], os.path.join(out, "map.log")))
+    dumps = read_callgrind_dumps(out)
+    if len(dumps) != len(spans) or any(frames == 0 for _, frames, _ in dumps):
+        sys.exit("benchmark --long --instructions: expected %d callgrind dumps with frames in %s, "
+                 "found %s" % (len(spans), out, dumps))
+    per_frame = [instructions / frames / 1e6 for _, frames, instructions in dumps]
+    km = [index.distance_m[bisect.bisect_left(index.stamps, float(s.split(":")[0]))] / 1e3 +
+          index.total_m / count / 2e3 for s in spans]
+    fmt = benchmark.fmt
+    return [["instructions / frame, copies %s at %s km (callgrind, %s frames)" % (
+                 " / ".join(str(k + 1) for k in INSTRUCTION_COPIES),
+                 " / ".join(fmt(d, 1) for d in km),
+                 " / ".join(str(frames) for _, frames, _ in dumps)),
+             "%s M (valgrind run %.0f s)" % (" / ".join(fmt(x, 1) for x in per_frame), wall)],
+            ["instructions / frame, last copy counted / first", fmt(per_frame[-1] / per_frame[0], 2)]]
+
+
 def main(args, out_root):
     """The long-drive benchmark; prints its table."""
     require_stats_option(args)
@@ -229,10 +312,11 @@ def main(args, out_root):
     gen_wall, gen_cpu = generate_drive(args, drive)
     print("[benchmark] %s: mapping (config/mapper.yaml)" % SCENARIO, file=sys.stderr)
     map_wall, map_cpu = map_drive(args, drive, out)
-    report(args, drive, out, (gen_wall, gen_cpu), (map_wall, map_cpu))
+    extra = instruction_rows(args, drive, out_root) if args.instructions else []
+    report(args, drive, out, (gen_wall, gen_cpu), (map_wall, map_cpu), extra)
 
 
-def report(args, drive, out, generate_time, map_time):
+def report(args, drive, out, generate_time, map_time, extra_rows=()):
     """Evaluates a mapped long drive (map.json, stats.csv, map.log in `out`); prints the table."""
     (gen_wall, gen_cpu), (map_wall, map_cpu) = generate_time, map_time
     print("[benchmark] %s: evaluating" % SCENARIO, file=sys.stderr)
@@ -258,6 +342,7 @@ def report(args, drive, out, generate_time, map_time):
                      % (k + 1, k * total_km / TENTHS, (k + 1) * total_km / TENTHS), fmt(ms, 2)])
     ratio = tenths[-1] / tenths[0] if tenths[0] and tenths[-1] is not None else None
     rows.append(["CPU last tenth / first tenth", fmt(ratio, 2)])
+    rows += list(extra_rows)
     rss_mb = [row[3] / 1024.0 for row in stats]
     rows.append(["peak RSS", "%s MB" % fmt(max(rss_mb), 1)])
     growth = slope([d / 1e3 for d in distances], rss_mb)
