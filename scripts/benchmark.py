@@ -219,7 +219,7 @@ def main():
                         help="the long-drive benchmark only (10 km, scripts/benchmark_long.py)")
     parser.add_argument("--instructions", action="store_true",
                         help="with --long: also count instructions per frame of three copies of "
-                             "the route under callgrind (about 30 min more)")
+                             "the route under callgrind (hours: valgrind is 20-30x slower)")
     args = parser.parse_args()
     args.shared = args.shared or os.path.join(args.repo, "..", "shared")
     out_root = args.out or os.path.join(args.repo, "out", "benchmark")

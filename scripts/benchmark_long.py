@@ -278,7 +278,8 @@ def instruction_rows(args, drive, out_root):
     index = long_drive_split.DriveIndex(gt["frames"])
     count = repeat_count(args)
     spans = copy_spans(index, INSTRUCTION_COPIES, count)
-    print("[benchmark] %s: counting instructions of copies %s under callgrind (about 30 min)"
+    print("[benchmark] %s: counting instructions of copies %s under callgrind (slow: valgrind "
+          "runs map_from_bag 20-30x slower than natively, hours for the 10 km drive)"
           % (SCENARIO, ", ".join(str(k + 1) for k in INSTRUCTION_COPIES)), file=sys.stderr)
     wall, _ = timed(lambda: benchmark.run(
         ["valgrind", "--tool=callgrind", "--instr-atstart=no",
