@@ -51,6 +51,95 @@ TEST(FitLaneEnds, ExtendsByWholeChordSpacingsAlongTheLine) {
               1e-9);
 }
 
+// Control points every 3 m of arc along a circle of radius R through the origin (center at
+// (0, side R): side +1 a left turn), from arc length s0 to s1, phantom ends included.
+std::vector<Eigen::Vector3d> ArcControlPoints(double R, double side, double s0, double s1) {
+  std::vector<Eigen::Vector3d> cps;
+  for (double s = s0 - 3.0; s <= s1 + 3.0 + 1e-9; s += 3.0) {
+    cps.emplace_back(R * std::sin(s / R), side * R * (1.0 - std::cos(s / R)), 0.0);
+  }
+  return cps;
+}
+
+// An end on an R 30 m arc (curvy's tightest) with growth points on the arc beyond it. Grown
+// straight along the last chord (main's growth), the new control points leave the line by
+// about d^2 / 2R (1.7 m in 10 m) and the points past 8 m are no longer within
+// max_point_distance_m of the tangent line; grown along the arc of the line's curvature,
+// they stay on it, for left and right turns and at the start.
+TEST(FitLaneEnds, GrowsAlongTheArcOfTheGivenCurvature) {
+  const double R = 30.0;
+  for (const double side : {1.0, -1.0}) {
+    const auto cps = ArcControlPoints(R, side, 0.0, 12.0);
+    std::vector<Eigen::Vector3d> beyond;
+    for (double s = 12.5; s <= 24.0 + 1e-9; s += 0.25) {
+      beyond.emplace_back(R * std::sin(s / R), side * R * (1.0 - std::cos(s / R)), 0.0);
+    }
+    const auto on_arc = [&](const Eigen::Vector3d& p) {
+      return std::abs(std::hypot(p.x(), p.y() - side * R) - R);
+    };
+    LaneEndFitOptions options;
+    // Growth alone: no refinement samples, so the new points are where the growth put them.
+    const auto straight = FitLaneEnds(cps, {}, options, nullptr, &beyond);
+    const auto curved =
+        FitLaneEnds(cps, {}, options, nullptr, &beyond, LaneEndCurvatures{0.0, side / R});
+    ASSERT_EQ(curved.size(), cps.size() + 4);  // 12 m of arc: 4 chords
+    double straight_error = 0.0, curved_error = 0.0;
+    for (std::size_t i = cps.size() - 1; i + 1 < straight.size(); ++i) {
+      straight_error = std::max(straight_error, on_arc(straight[i]));
+    }
+    for (std::size_t i = cps.size() - 1; i + 1 < curved.size(); ++i) {
+      curved_error = std::max(curved_error, on_arc(curved[i]));
+    }
+    // What is left on the arc is the refinement's second differences (0.3 m per chord on
+    // R 30 m), which pull toward a straight line against the weak growth points.
+    EXPECT_GT(straight_error, 0.5) << "side " << side;
+    EXPECT_LT(curved_error, 0.15) << "side " << side;
+    // The start, grown backwards along the same circle (the lane's start-to-end curvature).
+    std::vector<Eigen::Vector3d> before;
+    for (double s = -0.5; s >= -9.0 - 1e-9; s -= 0.25) {
+      before.emplace_back(R * std::sin(s / R), side * R * (1.0 - std::cos(s / R)), 0.0);
+    }
+    int added_at_start = 0;
+    const auto at_start =
+        FitLaneEnds(cps, {}, options, &added_at_start, &before, LaneEndCurvatures{side / R, 0.0});
+    ASSERT_EQ(added_at_start, 3);
+    for (int i = 1; i <= 3; ++i) EXPECT_LT(on_arc(at_start[i]), 0.15) << "side " << side;
+  }
+}
+
+// Leaving a curve: the path's curvature still has the arc's while the end is already past
+// it. When the points beyond the end lie along the straight line, not the arc, the end grows
+// straight (as with no curvature).
+TEST(FitLaneEnds, AnEndPastTheCurveGrowsStraightWhenItsPointsDo) {
+  const double R = 30.0;
+  const auto cps = ArcControlPoints(R, 1.0, 0.0, 12.0);
+  const double a = 12.0 / R;
+  const Eigen::Vector3d end(R * std::sin(a), R * (1.0 - std::cos(a)), 0.0);
+  const Eigen::Vector3d tangent(std::cos(a), std::sin(a), 0.0);
+  std::vector<Eigen::Vector3d> beyond;
+  for (double s = 0.5; s <= 12.0 + 1e-9; s += 0.25) beyond.push_back(end + s * tangent);
+  const LaneEndFitOptions options;
+  const auto straight = FitLaneEnds(cps, {}, options, nullptr, &beyond);
+  const auto curved =
+      FitLaneEnds(cps, {}, options, nullptr, &beyond, LaneEndCurvatures{0.0, 1.0 / R});
+  ASSERT_GT(straight.size(), cps.size());
+  EXPECT_EQ(curved, straight);
+}
+
+// Curved growth still ignores a neighbour's points: the line 3.5 m inside on the same arc.
+TEST(FitLaneEnds, CurvedGrowthIgnoresTheConcentricNeighbour) {
+  const double R = 30.0;
+  const auto cps = ArcControlPoints(R, 1.0, 0.0, 12.0);
+  std::vector<Eigen::Vector3d> neighbour;
+  const double r = R - 3.5;
+  for (double s = 12.5; s <= 24.0 + 1e-9; s += 0.25) {
+    neighbour.emplace_back(r * std::sin(s / R), R - r * std::cos(s / R), 0.0);
+  }
+  EXPECT_EQ(FitLaneEnds(cps, {}, LaneEndFitOptions(), nullptr, &neighbour,
+                        LaneEndCurvatures{0.0, 1.0 / R}),
+            cps);
+}
+
 TEST(FitLaneEnds, FewOrDistantPointsDoNotExtend) {
   const auto cps = StraightControlPoints(0.0, 12.0);
   // Four points past the end (one fewer than min_points_to_extend)...

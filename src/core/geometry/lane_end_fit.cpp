@@ -28,31 +28,93 @@ Eigen::Vector4d Basis(double u) {
                                u + 4.0 * u2 - 3.0 * u3, -u2 + u3);
 }
 
-// Appends control points at the end of `cps` (phantom last) for the points beyond it.
-// Returns how many were added.
+// Below this |curvature| (1/m) an end grows straight (the exact straight-line code).
+constexpr double kMinArcCurvature = 1e-6;
+// Points beyond a curved end count up to this turn of the arc (rad).
+constexpr double kMaxArcTurn = 1.5;
+
+// Appends control points at the end of `cps` (phantom last) for the points beyond it, along
+// the arc of signed curvature `curvature` (0: straight). Returns how many were added.
 int ExtendEnd(const LaneEndFitOptions& options, const std::vector<Eigen::Vector3d>& points,
-              std::vector<Eigen::Vector3d>* cps) {
+              double curvature, std::vector<Eigen::Vector3d>* cps) {
   const std::size_t n = cps->size();
   const Eigen::Vector3d end = (*cps)[n - 2];
   Eigen::Vector3d tangent = end - (*cps)[n - 3];
   if (tangent.norm() < 1e-9) return 0;
+  const double chord_m = tangent.head<2>().norm();
   tangent.normalize();
+  const double horizontal = tangent.head<2>().norm();
   std::vector<double> beyond;
+  if (std::abs(curvature) < kMinArcCurvature || horizontal < 1e-6) {
+    for (const Eigen::Vector3d& p : points) {
+      const Eigen::Vector3d d = p - end;
+      const double along = d.dot(tangent);
+      if (along <= 0.0) continue;
+      if ((d - along * tangent).norm() > options.max_point_distance_m) continue;
+      beyond.push_back(along);
+    }
+    if (static_cast<int>(beyond.size()) < options.min_points_to_extend) return 0;
+    std::nth_element(beyond.begin(), beyond.end() - 2, beyond.end());
+    const double reach = beyond[beyond.size() - 2];
+    const int add = static_cast<int>(std::floor(reach / options.chord_spacing_m + 0.5));
+    if (add <= 0) return 0;
+    cps->pop_back();  // the old phantom
+    for (int k = 1; k <= add; ++k) cps->push_back(end + k * options.chord_spacing_m * tangent);
+    cps->push_back(2.0 * cps->back() - (*cps)[cps->size() - 2]);
+    return add;
+  }
+  // The arc: the end's tangent is the last chord turned by half its angle; horizontal frame
+  // (t along, l left) at the end, the arc's center at l = 1 / curvature.
+  const double turn = 0.5 * curvature * chord_m;
+  const Eigen::Vector2d chord_dir = tangent.head<2>() / horizontal;
+  const Eigen::Vector2d t(std::cos(turn) * chord_dir.x() - std::sin(turn) * chord_dir.y(),
+                          std::sin(turn) * chord_dir.x() + std::cos(turn) * chord_dir.y());
+  const Eigen::Vector2d l(-t.y(), t.x());
+  const double radius = 1.0 / std::abs(curvature), side = curvature > 0.0 ? 1.0 : -1.0;
+  const double slope = tangent.z() / horizontal;  // dz per horizontal meter
+  // Each point beyond the end measured across the arc and across the straight tangent line:
+  // the points choose (median distance) whether the line goes on along the arc or straight
+  // (leaving a curve, the path's curvature still has the arc's while the end is past it).
+  std::vector<double> across_arc, across_line;
   for (const Eigen::Vector3d& p : points) {
-    const Eigen::Vector3d d = p - end;
-    const double along = d.dot(tangent);
-    if (along <= 0.0) continue;
-    if ((d - along * tangent).norm() > options.max_point_distance_m) continue;
+    const Eigen::Vector2d d = (p - end).head<2>();
+    // From the center: (radius sin(theta), -side radius cos(theta)) at arc angle theta.
+    const Eigen::Vector2d v(d.dot(t), d.dot(l) - side * radius);
+    const double theta = std::atan2(v.x(), -side * v.y());
+    if (theta <= 0.0 || theta > kMaxArcTurn) continue;
+    const double along = theta * radius;
+    const double up = p.z() - end.z() - slope * along;
+    const double across = std::hypot(v.norm() - radius, up);
+    const Eigen::Vector3d e = p - end;
+    const double straight_along = e.dot(tangent);
+    const double straight_across =
+        straight_along > 0.0 ? (e - straight_along * tangent).norm() : across;
+    if (std::min(across, straight_across) > options.max_point_distance_m) continue;
+    across_arc.push_back(across);
+    across_line.push_back(straight_across);
+    if (across > options.max_point_distance_m) continue;
     beyond.push_back(along);
+  }
+  if (!across_arc.empty()) {
+    const std::size_t mid = across_arc.size() / 2;
+    std::nth_element(across_arc.begin(), across_arc.begin() + mid, across_arc.end());
+    std::nth_element(across_line.begin(), across_line.begin() + mid, across_line.end());
+    if (across_line[mid] < across_arc[mid]) return ExtendEnd(options, points, 0.0, cps);
   }
   if (static_cast<int>(beyond.size()) < options.min_points_to_extend) return 0;
   // The second-farthest point: one stray sample does not stretch the lane.
   std::nth_element(beyond.begin(), beyond.end() - 2, beyond.end());
   const double reach = beyond[beyond.size() - 2];
-  const int add = static_cast<int>(std::floor(reach / options.chord_spacing_m + 0.5));
+  const double step_m = options.chord_spacing_m * horizontal;  // as the straight growth
+  const int add = static_cast<int>(std::floor(reach / step_m + 0.5));
   if (add <= 0) return 0;
   cps->pop_back();  // the old phantom
-  for (int k = 1; k <= add; ++k) cps->push_back(end + k * options.chord_spacing_m * tangent);
+  for (int k = 1; k <= add; ++k) {
+    const double s = k * step_m, angle = s * curvature;
+    const Eigen::Vector2d xy = end.head<2>() + t * (std::sin(angle) / curvature) +
+                               l * ((1.0 - std::cos(angle)) / curvature);
+    cps->emplace_back(xy.x(), xy.y(), end.z() + slope * s);
+  }
   cps->push_back(2.0 * cps->back() - (*cps)[cps->size() - 2]);
   return add;
 }
@@ -69,7 +131,8 @@ struct Dependence {
 std::vector<Eigen::Vector3d> FitLaneEnds(const std::vector<Eigen::Vector3d>& control_points,
                                          const std::vector<Eigen::Vector3d>& points,
                                          const LaneEndFitOptions& options, int* added_at_start,
-                                         const std::vector<Eigen::Vector3d>* extension_points) {
+                                         const std::vector<Eigen::Vector3d>* extension_points,
+                                         const LaneEndCurvatures& curvatures) {
   if (control_points.size() < 4) {
     throw std::invalid_argument("FitLaneEnds needs at least 4 control points");
   }
@@ -86,9 +149,10 @@ std::vector<Eigen::Vector3d> FitLaneEnds(const std::vector<Eigen::Vector3d>& con
       extension_points ? finite_of(*extension_points) : finite;
   // 1. Grow both ends (the start by growing the reversed lane's end).
   std::vector<Eigen::Vector3d> cps = control_points;
-  ExtendEnd(options, growth, &cps);
+  ExtendEnd(options, growth, curvatures.at_end, &cps);
   std::reverse(cps.begin(), cps.end());
-  const int at_start = ExtendEnd(options, growth, &cps);
+  // Reversed, the start's curve turns the other way.
+  const int at_start = ExtendEnd(options, growth, -curvatures.at_start, &cps);
   std::reverse(cps.begin(), cps.end());
   if (added_at_start) *added_at_start = at_start;
 
@@ -234,7 +298,7 @@ std::vector<Eigen::Vector3d> FitLaneEnds(const std::vector<Eigen::Vector3d>& con
 void FitLaneEndsNear(const LaneEndFitOptions& options, const std::vector<Eigen::Vector3d>& points,
                      const std::vector<Eigen::Vector3d>& extension_points,
                      std::vector<Eigen::Vector3d>* cps, int* added_at_start,
-                     std::size_t* first_changed) {
+                     std::size_t* first_changed, const LaneEndCurvatures& curvatures) {
   std::vector<Eigen::Vector3d> near = points;
   near.insert(near.end(), extension_points.begin(), extension_points.end());
   near.erase(std::remove_if(near.begin(), near.end(),
@@ -251,13 +315,13 @@ void FitLaneEndsNear(const LaneEndFitOptions& options, const std::vector<Eigen::
   const std::vector<Eigen::Vector3d> slice(cps->begin() + first, cps->begin() + last + 1);
   int added = 0;
   std::vector<Eigen::Vector3d> fitted =
-      FitLaneEnds(slice, points, options, &added, &extension_points);
+      FitLaneEnds(slice, points, options, &added, &extension_points, curvatures);
   const bool starts_inside = first > 0, ends_inside = last + 1 < cps->size();
   // A slice end inside the lane must come back as it was (else: the whole lane, as before).
   if ((starts_inside && (added != 0 || fitted.front() != slice.front())) ||
       (ends_inside && (fitted.size() != slice.size() + static_cast<std::size_t>(added) ||
                        fitted.back() != slice.back()))) {
-    *cps = FitLaneEnds(*cps, points, options, added_at_start, &extension_points);
+    *cps = FitLaneEnds(*cps, points, options, added_at_start, &extension_points, curvatures);
     if (first_changed) *first_changed = 0;
     return;
   }

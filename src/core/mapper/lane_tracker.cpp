@@ -7,6 +7,7 @@
 #include "ipm_road_mapper/core/geometry/ipm.h"
 #include "ipm_road_mapper/core/geometry/lane_end_fit.h"
 #include "ipm_road_mapper/core/geometry/spline_fitting.h"
+#include "ipm_road_mapper/core/mapper/path_curvature.h"
 #include "ipm_road_mapper/core/mapper/window_coordinator.h"
 
 namespace ipm_road_mapper {
@@ -119,10 +120,15 @@ std::size_t LaneTracker::Grow(LaneElement* lane, std::size_t frame_index,
     if (m->frame_index + horizon <= frame_index) break;
     points.insert(points.end(), m->selected_map.begin(), m->selected_map.end());
   }
+  // The ends grow along the driven path's curve, offset kept (path_curvature.h).
+  const LaneEndCurvatures curvatures = PathEndCurvatures(
+      store_->frames(), frame_index, options_.lanes.end_growth_path_length_m,
+      MinGrowthCurvature(options_.association.lane_gate_m, options_.association.lane_max_end_gap_m),
+      lane->control_points_map);
   int added_at_start = 0;
   std::size_t first_changed = 0;
   FitLaneEndsNear(options_.lanes.end_fit, points, usable_map, &lane->control_points_map,
-                  &added_at_start, &first_changed);
+                  &added_at_start, &first_changed, curvatures);
   lane->first_cp_index -= added_at_start;  // keeps older back-end results applicable
   return first_changed;
 }

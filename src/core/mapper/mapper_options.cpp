@@ -71,6 +71,7 @@ LaneOptions LoadLaneOptions(OptionsReader reader) {
   reader.Read<double>("smoothing_length_m", &o.fit.smoothing_length_m, CheckPositive);
   o.end_fit.chord_spacing_m = o.fit.chord_spacing_m;
   reader.Read<int>("end_fit_frames", &o.end_fit_frames, CheckPositiveInt);
+  reader.Read<double>("end_growth_path_length_m", &o.end_growth_path_length_m, CheckNonNegative);
   reader.Read<int>("end_fit_min_points", &o.end_fit.min_points_to_extend, CheckPositiveInt);
   reader.Read<double>("end_fit_max_point_distance_m", &o.end_fit.max_point_distance_m,
                       CheckPositive);

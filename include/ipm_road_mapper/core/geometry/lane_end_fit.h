@@ -4,7 +4,8 @@
 // observations to FitLaneEnds, which
 //  1. extends an end by whole chord spacings when enough points lie beyond it (along the
 //     end tangent, within max_point_distance_m of its line), new control points placed
-//     straight ahead;
+//     straight ahead, or along an arc of a given curvature (LaneEndCurvatures: the mapper
+//     passes the driven path's, so that an end on a curve grows along the line);
 //  2. re-estimates, by robust linear least squares, the real control points of the segments
 //     the points fall on; the rest of the lane is held exactly.
 // Step 2, with the points' curve parameters u_i (closest points) held fixed, is linear in
@@ -35,6 +36,16 @@ struct LaneEndFitOptions {
   double extension_weight = 0.1;      // weight of the growth points in the fit (see below)
 };
 
+// Signed horizontal curvatures (1/m, left turns positive, in the lane's start-to-end
+// direction) of the arcs along which the lane's start and end grow. 0: straight ahead along
+// the last chord. With a curvature, an end's tangent is its last chord turned by half the
+// chord's angle, the points beyond it are measured along and across that arc, and the new
+// control points lie on it.
+struct LaneEndCurvatures {
+  double at_start = 0.0;
+  double at_end = 0.0;
+};
+
 // Extends and refines a lane's control points (phantom ends included, >= 4) with `points`
 // (map frame, the lane's recent observations). Returns the new control points; control
 // points that no point reaches are returned bit for bit, in place, and new ones are only
@@ -48,7 +59,8 @@ struct LaneEndFitOptions {
 std::vector<Eigen::Vector3d> FitLaneEnds(
     const std::vector<Eigen::Vector3d>& control_points, const std::vector<Eigen::Vector3d>& points,
     const LaneEndFitOptions& options, int* added_at_start = nullptr,
-    const std::vector<Eigen::Vector3d>* extension_points = nullptr);
+    const std::vector<Eigen::Vector3d>* extension_points = nullptr,
+    const LaneEndCurvatures& curvatures = LaneEndCurvatures());
 
 // FitLaneEnds(*control_points, points, options, added_at_start, &extension_points) in place,
 // on the part of the lane near the points only: a lane can be kilometers long, and a frame
@@ -59,6 +71,7 @@ std::vector<Eigen::Vector3d> FitLaneEnds(
 void FitLaneEndsNear(const LaneEndFitOptions& options, const std::vector<Eigen::Vector3d>& points,
                      const std::vector<Eigen::Vector3d>& extension_points,
                      std::vector<Eigen::Vector3d>* control_points, int* added_at_start,
-                     std::size_t* first_changed = nullptr);
+                     std::size_t* first_changed = nullptr,
+                     const LaneEndCurvatures& curvatures = LaneEndCurvatures());
 
 }  // namespace ipm_road_mapper

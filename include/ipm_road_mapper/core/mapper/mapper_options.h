@@ -44,6 +44,9 @@ struct LaneOptions {
   SplineFitOptions fit;                // g: chord spacing etc. (starts a lane)
   LaneEndFitOptions end_fit;           // growth of a lane's ends (chord spacing = g's)
   int end_fit_frames = 20;             // the growth sees the selected points of this many frames
+  // A lane's ends grow along the arc concentric with the driven path's curvature over this
+  // length (heading change / distance); 0: straight along the last chord.
+  double end_growth_path_length_m = 10.0;
   int merge_every_n_frames = 20;       // how often lanes that turned out to be one are merged
   double min_new_lane_length_m = 3.0;  // an unmatched observation shorter than this: no lane
   LaneJoinOptions join;                // joining the fragments of one line (lane_join.h)
