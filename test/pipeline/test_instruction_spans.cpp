@@ -1,10 +1,10 @@
-#include "ipm_road_mapper/pipeline/instruction_spans.h"
-
 #include <gtest/gtest.h>
 
 #include <stdexcept>
 #include <string>
 #include <vector>
+
+#include "ipm_road_mapper/pipeline/instruction_spans.h"
 
 namespace ipm_road_mapper {
 namespace {
@@ -28,8 +28,8 @@ TEST(InstructionSpans, ParsesSpansInOrder) {
 }
 
 TEST(InstructionSpans, RejectsMalformedSpans) {
-  for (const char* bad : {"", "1", "1:", ":2", "a:2", "1:2x", "3:2", "2:2", "1:3,2:4", "1:nan",
-                          "1:inf", "1:2,"}) {
+  for (const char* bad :
+       {"", "1", "1:", ":2", "a:2", "1:2x", "3:2", "2:2", "1:3,2:4", "1:nan", "1:inf", "1:2,"}) {
     EXPECT_THROW(ParseStampSpans(bad), std::invalid_argument) << "'" << bad << "'";
   }
 }

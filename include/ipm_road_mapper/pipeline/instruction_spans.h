@@ -71,7 +71,7 @@ class InstructionSpans {
   InstructionCounterHooks hooks_;
   std::size_t next_ = 0;  // the span to start (or the open one while active_)
   bool active_ = false;
-  std::size_t frames_ = 0;   // frames processed since the open span started
+  std::size_t frames_ = 0;    // frames processed since the open span started
   double first_stamp_ = 0.0;  // stamp of the frame after which counting started
   double last_stamp_ = 0.0;
   std::size_t dumped_ = 0;
