@@ -40,6 +40,22 @@ TEST(PathCurvature, ReadsTheArcsCurvatureAndZeroWhenStraightOrShort) {
   EXPECT_EQ(PathCurvature(ArcFrames(R, 1.0, 60), 59, 0.0), 0.0);  // switched off
 }
 
+// After a long stop the chord would reach back to the curve driven before it: no curvature
+// is read from more than 20 s back, and the walk does not go through the whole stop.
+TEST(PathCurvature, ALongStandstillAfterAnArcReadsNoCurvature) {
+  std::vector<FrameRecord> frames = ArcFrames(30.0, 1.0, 60);
+  for (std::size_t k = 0; k < frames.size(); ++k) frames[k].stamp = 0.05 * static_cast<double>(k);
+  EXPECT_NEAR(PathCurvature(frames, 59, 10.0), 1.0 / 30.0, 1e-3);
+  const FrameRecord last = frames.back();
+  for (std::size_t k = 1; k <= 600; ++k) {  // 30 s standing still
+    FrameRecord f = last;
+    f.index = last.index + k;
+    f.stamp = last.stamp + 0.05 * static_cast<double>(k);
+    frames.push_back(f);
+  }
+  EXPECT_EQ(PathCurvature(frames, frames.size() - 1, 10.0), 0.0);
+}
+
 TEST(PathCurvature, LinesBesideTheArcTurnAboutItsCenter) {
   const double R = 30.0;
   for (const double side : {1.0, -1.0}) {

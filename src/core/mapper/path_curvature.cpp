@@ -4,6 +4,10 @@
 
 namespace ipm_road_mapper {
 
+namespace {
+constexpr double kMaxChordSeconds = 20.0;  // slower than length_m per 20 s: no curvature read
+}  // namespace
+
 double PathCurvature(const std::vector<FrameRecord>& frames, std::size_t index, double length_m) {
   if (length_m <= 0.0 || index >= frames.size()) return 0.0;
   // The chord from the frame `length_m` back: per-frame position jitter (0.4 m at the
@@ -11,7 +15,11 @@ double PathCurvature(const std::vector<FrameRecord>& frames, std::size_t index, 
   const Eigen::Vector2d p_now = frames[index].T_map_base.translation().head<2>();
   std::size_t k = index;
   double driven = 0.0;
-  while (k > 0 && driven < length_m) {
+  // Not past kMaxChordSeconds: at a standstill the chord never reaches length_m, and the walk
+  // would go back through every frame of the stop (a cost growing with its length) to a
+  // curve driven before it, which is not the path's curvature now.
+  while (k > 0 && driven < length_m &&
+         frames[index].stamp - frames[k - 1].stamp <= kMaxChordSeconds) {
     --k;
     driven = (p_now - frames[k].T_map_base.translation().head<2>()).norm();
   }
