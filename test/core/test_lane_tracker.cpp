@@ -25,6 +25,12 @@ struct Rig : RoomRig {
   LaneTracker tracker{options, &store, &counters};
 };
 
+// Adds a lane to the store as its writers do: pushed and touched (indexed by place).
+void AddLane(RoomRig* rig, LaneElement lane) {
+  rig->store.lanes().push_back(std::move(lane));
+  rig->store.Touch(&rig->store.lanes().back());
+}
+
 double MaxX(const std::vector<Eigen::Vector3d>& cps) {
   double x = -1e9;
   for (std::size_t i = 1; i + 1 < cps.size(); ++i) x = std::max(x, cps[i].x());
@@ -58,7 +64,7 @@ TEST(LaneTracker, TwoLanesAlongOneLineAreMerged) {
   LaneElement second = rig.store.lanes()[0];
   second.id = rig.store.NewId();
   for (Eigen::Vector3d& c : second.control_points_map) c.x() += 9.0;
-  rig.store.lanes().push_back(second);
+  AddLane(&rig, second);
   rig.Step(RoadFrame(100.05, 1.0, false));
   EXPECT_EQ(rig.store.lanes().size(), 1u);
   EXPECT_EQ(rig.counters.lanes_merged, 1u);
@@ -80,10 +86,10 @@ TEST(LaneTracker, LongLanesMergeAlongOneLineOnly) {
     }
     return lane;
   };
-  rig.store.lanes().push_back(straight(-30.0, 0.0, 3000.0));
-  rig.store.lanes().push_back(straight(-29.9, 1500.0, 4500.0));  // the same line, 1.5 km on
-  rig.store.lanes().push_back(straight(-26.5, 0.0, 3000.0));     // the next line, 3.5 m beside
-  rig.Step(RoadFrame(100.0, 0.0, false));
+  AddLane(&rig, straight(-30.0, 0.0, 3000.0));
+  AddLane(&rig, straight(-29.9, 1500.0, 4500.0));  // the same line, 1.5 km on
+  AddLane(&rig, straight(-26.5, 0.0, 3000.0));     // the next line, 3.5 m beside
+  rig.Step(RoadFrame(100.0, 1600.0, false));       // where they overlap (merges are local)
   EXPECT_EQ(rig.counters.lanes_merged, 1u);
   std::size_t on_the_line = 0, beside = 0;
   for (const LaneElement& lane : rig.store.lanes()) {
@@ -96,14 +102,38 @@ TEST(LaneTracker, LongLanesMergeAlongOneLineOnly) {
   EXPECT_EQ(beside, 1u);
 }
 
+// Lanes are never retired, so the per-frame work must not visit the drive's lanes: two lanes
+// along one line 2 km behind the vehicle are left alone (the tracker looks at the lanes near
+// the vehicle, MapStore::LanesNear), and merged once the vehicle is there again.
+TEST(LaneTracker, FarLanesAreLeftAloneUntilTheVehicleIsNear) {
+  MapperOptions options;
+  options.lanes.merge_every_n_frames = 1;
+  Rig rig(options);
+  auto straight = [&](double x0, double x1) {
+    LaneElement lane;
+    lane.id = rig.store.NewId();
+    lane.class_id = 1;  // not the scene's dashed line
+    for (double x = x0 - 3.0; x <= x1 + 3.0 + 1e-9; x += 3.0) {
+      lane.control_points_map.emplace_back(x, -30.0, 0.0);
+    }
+    return lane;
+  };
+  AddLane(&rig, straight(2000.0, 2100.0));
+  AddLane(&rig, straight(2050.0, 2150.0));  // along the first: one line
+  for (int k = 0; k < 5; ++k) rig.Step(RoadFrame(100.0 + 0.05 * k, 1.0 * k, false));
+  EXPECT_EQ(rig.counters.lanes_merged, 0u);
+  EXPECT_EQ(rig.store.lanes().size(), 3u);  // the two and the scene's line
+  rig.Step(RoadFrame(200.0, 2060.0, false));
+  EXPECT_EQ(rig.counters.lanes_merged, 1u);
+}
+
 // Two fragments of one dashed line across a gap: lane 1 seen in frames 0-39, lane 2 from
 // frame 60 on.
 void AddFragments(Rig* rig) {
   std::mt19937 rng(7);
   const test::Line line = test::Straight(1.75);
-  rig->store.lanes().push_back(test::MakeLane(rig->store.NewId(), 2, line, 0.0, 40.0, 0, 40, &rng));
-  rig->store.lanes().push_back(
-      test::MakeLane(rig->store.NewId(), 2, line, 46.0, 100.0, 60, 120, &rng));
+  AddLane(rig, test::MakeLane(rig->store.NewId(), 2, line, 0.0, 40.0, 0, 40, &rng));
+  AddLane(rig, test::MakeLane(rig->store.NewId(), 2, line, 46.0, 100.0, 60, 120, &rng));
 }
 
 // Frames along x until the store holds `frames`.

@@ -56,14 +56,53 @@ TEST(MapStore, RoadDirectionIsTheNearestLanesTangent) {
   LaneElement diagonal;
   for (int i = -1; i <= 10; ++i)
     diagonal.control_points_map.emplace_back(3.0 * i, 3.0 * i - 9.0, 0.0);
-  store.lanes().push_back(along_x);
-  store.lanes().push_back(diagonal);
+  along_x.id = store.NewId();
+  diagonal.id = store.NewId();
+  for (const LaneElement* lane : {&along_x, &diagonal}) {
+    store.lanes().push_back(*lane);
+    store.Touch(&store.lanes().back());  // as every writer of a lane does: indexed by place
+  }
   const Eigen::Vector3d near_x = store.RoadDirectionAt(Eigen::Vector3d(10.0, 2.5, 0.0));
   EXPECT_NEAR(std::abs(near_x.x()), 1.0, 1e-6);
   const Eigen::Vector3d near_diagonal = store.RoadDirectionAt(Eigen::Vector3d(20.0, 11.5, 0.0));
   EXPECT_NEAR(std::abs(near_diagonal.x()), std::sqrt(0.5), 1e-3);
   // Farther than 8 m from every lane: no direction.
   EXPECT_EQ(store.RoadDirectionAt(Eigen::Vector3d(0.0, -30.0, 0.0)), Eigen::Vector3d::Zero());
+}
+
+LaneElement StraightLane(std::uint64_t id, double x0, double x1, double y) {
+  LaneElement lane;
+  lane.id = id;
+  for (double x = x0; x <= x1 + 1e-9; x += 3.0) lane.control_points_map.emplace_back(x, y, 0.0);
+  return lane;
+}
+
+TEST(MapStore, LanesAreFoundByPlace) {
+  MapStore store(4.0);
+  EXPECT_TRUE(store.LanesNear(Eigen::Vector3d::Zero(), 50.0).empty());
+  for (double x0 : {0.0, 1000.0, 2000.0}) {
+    store.lanes().push_back(StraightLane(store.NewId(), x0, x0 + 60.0, 0.0));
+    store.Touch(&store.lanes().back());
+  }
+  EXPECT_EQ(store.LanesNear(Eigen::Vector3d(30.0, 5.0, 0.0), 20.0), std::vector<std::size_t>{0});
+  EXPECT_EQ(store.LanesNear(Eigen::Vector3d(2030.0, 0.0, 0.0), 20.0), std::vector<std::size_t>{2});
+  EXPECT_TRUE(store.LanesNear(Eigen::Vector3d(500.0, 0.0, 0.0), 20.0).empty());
+  // Grown towards a place (only the new points are touched): found there.
+  LaneElement& grown = store.lanes()[1];
+  const std::size_t before = grown.control_points_map.size();
+  for (double x = 1063.0; x <= 1500.0; x += 3.0) grown.control_points_map.emplace_back(x, 0.0, 0.0);
+  store.Touch(&grown, before);
+  EXPECT_EQ(store.LanesNear(Eigen::Vector3d(1400.0, 0.0, 0.0), 10.0), std::vector<std::size_t>{1});
+  // A lane removed from the map is no longer found, and the indices of the others follow.
+  store.lanes().erase(store.lanes().begin());
+  EXPECT_TRUE(store.LanesNear(Eigen::Vector3d(30.0, 0.0, 0.0), 20.0).empty());
+  EXPECT_EQ(store.LanesNear(Eigen::Vector3d(1400.0, 0.0, 0.0), 10.0), std::vector<std::size_t>{0});
+  EXPECT_EQ(store.LanesNear(Eigen::Vector3d(2030.0, 0.0, 0.0), 20.0), std::vector<std::size_t>{1});
+  // A disc wider than the indexed cells: every lane, ascending.
+  EXPECT_EQ(store.LanesNear(Eigen::Vector3d(1000.0, 0.0, 0.0), 1e6),
+            (std::vector<std::size_t>{0, 1}));
+  store.Clear();
+  EXPECT_TRUE(store.LanesNear(Eigen::Vector3d(1400.0, 0.0, 0.0), 10.0).empty());
 }
 
 MarkingElement MarkingAt(std::uint64_t id, double x, double y, std::size_t last_frame) {

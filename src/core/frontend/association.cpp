@@ -297,15 +297,29 @@ double LaneAssociationCost(const LaneElement& lane, const LaneCandidate& candida
 std::vector<int> AssociateLanes(const std::vector<LaneElement>& lanes,
                                 const std::vector<LaneCandidate>& candidates,
                                 const AssociationOptions& options) {
+  std::vector<std::size_t> all(lanes.size());
+  for (std::size_t i = 0; i < all.size(); ++i) all[i] = i;
+  return AssociateLanes(lanes, all, candidates, options);
+}
+
+std::vector<int> AssociateLanes(const std::vector<LaneElement>& lanes,
+                                const std::vector<std::size_t>& among,
+                                const std::vector<LaneCandidate>& candidates,
+                                const AssociationOptions& options) {
+  // Pairs by position in `among`: ascending, so ties break as over all lanes.
   std::vector<std::tuple<double, int, int>> pairs;
   for (int c = 0; c < static_cast<int>(candidates.size()); ++c) {
-    for (int e = 0; e < static_cast<int>(lanes.size()); ++e) {
-      const double cost = LaneAssociationCost(lanes[e], candidates[c], options);
-      if (cost >= 0.0) pairs.emplace_back(cost, c, e);
+    for (int k = 0; k < static_cast<int>(among.size()); ++k) {
+      const double cost = LaneAssociationCost(lanes[among[k]], candidates[c], options);
+      if (cost >= 0.0) pairs.emplace_back(cost, c, k);
     }
   }
-  return AssignGreedy(std::move(pairs), static_cast<int>(candidates.size()),
-                      static_cast<int>(lanes.size()));
+  std::vector<int> match = AssignGreedy(std::move(pairs), static_cast<int>(candidates.size()),
+                                        static_cast<int>(among.size()));
+  for (int& m : match) {
+    if (m >= 0) m = static_cast<int>(among[m]);
+  }
+  return match;
 }
 
 }  // namespace ipm_road_mapper

@@ -13,6 +13,31 @@
 namespace ipm_road_mapper {
 namespace {
 
+// The radius about `center` of a disc that holds every point within the association's
+// reach of the candidates' points: LaneAssociationCost looks only at the control points in
+// the points' bounding box grown by `margin_m` (ControlPointRangeNear), so the farthest
+// corner of that box bounds it.
+double CandidateReach(const std::vector<LaneCandidate>& candidates, const Eigen::Vector3d& center,
+                      double margin_m) {
+  bool any = false;
+  Eigen::Vector2d lo = Eigen::Vector2d::Zero(), hi = lo;
+  for (const LaneCandidate& c : candidates) {
+    for (const Eigen::Vector3d& p : c.points_map) {
+      if (!p.allFinite()) continue;
+      lo = any ? lo.cwiseMin(p.head<2>()).eval() : p.head<2>();
+      hi = any ? hi.cwiseMax(p.head<2>()).eval() : p.head<2>();
+      any = true;
+    }
+  }
+  if (!any) return 0.0;
+  lo.array() -= margin_m;
+  hi.array() += margin_m;
+  const Eigen::Vector2d c = center.head<2>();
+  const Eigen::Vector2d far((c.x() - lo.x() > hi.x() - c.x()) ? lo.x() : hi.x(),
+                            (c.y() - lo.y() > hi.y() - c.y()) ? lo.y() : hi.y());
+  return (far - c).norm();
+}
+
 // Point selection (PS): flags of the points kept for control-point estimation.
 std::vector<std::uint8_t> SelectPoints(const std::vector<LanePoint>& points,
                                        const LaneOptions& options) {
@@ -91,7 +116,11 @@ void LaneTracker::Update(const std::vector<LaneObservation>& observations,
     measurements.push_back(std::move(measurement));
   }
   std::vector<LaneElement>& lanes = store_->lanes();
-  const std::vector<int> match = AssociateLanes(lanes, candidates, options_.association);
+  // Only the lanes within the candidates' reach (a neighbourhood, not the drive's lanes).
+  near_ = store_->LanesNear(
+      frame.T_map_base.translation(),
+      CandidateReach(candidates, frame.T_map_base.translation(), AssociationMarginM()));
+  const std::vector<int> match = AssociateLanes(lanes, near_, candidates, options_.association);
   for (std::size_t c = 0; c < candidates.size(); ++c) {
     // The start gate looks at every point of low enough uncertainty: the N best of PS alone
     // may all lie on the nearest dash of a dashed line, shorter than the gate.
@@ -143,8 +172,9 @@ void LaneTracker::Start(int class_id, const LaneMeasurement& measurement,
   loose.lane_gate_m *= 2.0;
   loose.lane_gate_sigmas *= 2.0;
   const LaneCandidate candidate{class_id, usable_map, {}, {}};
-  for (const LaneElement& lane : store_->lanes()) {
-    if (LaneAssociationCost(lane, candidate, loose) >= 0.0) {
+  const std::vector<LaneElement>& lanes = store_->lanes();
+  for (std::size_t i : near_) {
+    if (LaneAssociationCost(lanes[i], candidate, loose) >= 0.0) {
       ++counters_->lane_observations_near_lane;
       return;
     }
@@ -155,7 +185,8 @@ void LaneTracker::Start(int class_id, const LaneMeasurement& measurement,
   // at 0.5 m of odometry noise the loose ones reach the next lane's line, 3.5 m beside.
   AssociationOptions alongside = options_.association;
   alongside.lane_max_end_gap_m = 0.0;
-  for (const LaneElement& lane : store_->lanes()) {
+  for (std::size_t i : near_) {
+    const LaneElement& lane = lanes[i];
     if (lane.class_id == class_id) continue;
     const LaneCandidate as_its_class{lane.class_id, usable_map, {}, {}};
     if (LaneAssociationCost(lane, as_its_class, alongside) >= 0.0) {
@@ -183,6 +214,7 @@ void LaneTracker::Start(int class_id, const LaneMeasurement& measurement,
   lane.first_seen = lane.last_seen = frame.stamp;
   store_->Touch(&lane);
   store_->lanes().push_back(std::move(lane));
+  near_.push_back(store_->lanes().size() - 1);  // the frame's next candidates see it
   ++counters_->lanes_created;
 }
 
@@ -210,18 +242,20 @@ void LaneTracker::MergeLines() {
   // Two lanes of one class that turn out to be one line (e.g. one was started while the
   // other was not matched across a gap): the second's curve lies along the first.
   std::vector<LaneElement>& lanes = store_->lanes();
-  for (std::size_t a = 0; a < lanes.size(); ++a) {
-    for (std::size_t b = a + 1; b < lanes.size();) {
-      LaneElement& first = lanes[a];
+  std::vector<std::size_t> near = LanesThatMayHaveChanged();
+  for (std::size_t ai = 0; ai < near.size(); ++ai) {
+    for (std::size_t bi = ai + 1; bi < near.size();) {
+      const std::size_t b = near[bi];
+      LaneElement& first = lanes[near[ai]];
       LaneElement& second = lanes[b];
       if (first.class_id != second.class_id) {
-        ++b;
+        ++bi;
         continue;
       }
       const LaneCandidate candidate = SampledCandidate(second);
       if (candidate.points_map.size() < 2 ||
           LaneAssociationCost(first, candidate, options_.association) < 0.0) {
-        ++b;
+        ++bi;
         continue;
       }
       first.history.insert(first.history.end(), second.history.begin(), second.history.end());
@@ -246,11 +280,39 @@ void LaneTracker::MergeLines() {
       first.control_points_map = std::move(fitted);
       first.first_cp_index -= added_at_start;
       store_->Touch(&first, added_at_start > 0 ? 0 : changed_from);
-      lanes.erase(lanes.begin() + b);
+      lanes.erase(lanes.begin() + static_cast<std::ptrdiff_t>(b));
+      near.erase(near.begin() + static_cast<std::ptrdiff_t>(bi));
+      for (std::size_t k = bi; k < near.size(); ++k) --near[k];  // past b: one place down
       ++counters_->lanes_merged;
     }
   }
   JoinFragments(SettledBefore());
+}
+
+double LaneTracker::AssociationMarginM() const {
+  // LaneAssociationCost's margin about the points (association.cpp).
+  return options_.association.lane_max_end_gap_m + 5.0;
+}
+
+std::vector<std::size_t> LaneTracker::LanesThatMayHaveChanged() const {
+  // A lane changes while frames see it (growth, merges) or a window solves it: within the
+  // camera's range of the frames since the last merge or of the windows' frames. A merge or
+  // join pairs it with a lane within reach of it (the association's margin; a join's gap,
+  // overlap and two end models). Pairs of lanes that did not change were decided before.
+  const std::vector<FrameRecord>& frames = store_->frames();
+  if (frames.empty()) return {};
+  const std::size_t n = frames.size();
+  const std::size_t interval = static_cast<std::size_t>(options_.lanes.merge_every_n_frames);
+  const std::size_t from = std::min(SettledBefore(), n > interval ? n - interval : 0);
+  const Eigen::Vector3d now = frames.back().T_map_base.translation();
+  double travel_m = 0.0;
+  for (std::size_t i = from; i < n; ++i) {
+    travel_m = std::max(travel_m, (frames[i].T_map_base.translation() - now).head<2>().norm());
+  }
+  const LaneJoinOptions& join = options_.lanes.join;
+  const double reach_m =
+      std::max(AssociationMarginM(), join.max_gap_m + join.max_overlap_m + 2.0 * join.end_length_m);
+  return store_->LanesNear(now, travel_m + options_.ipm.max_range_m + reach_m);
 }
 
 std::size_t LaneTracker::SettledBefore() const {
@@ -267,11 +329,20 @@ void LaneTracker::JoinFragments(std::size_t settled_before_frame) {
   const double reach_m = join.max_gap_m + join.max_overlap_m + 2.0 * join.end_length_m;
   std::vector<LaneElement>& lanes = store_->lanes();
   // The best pair first, until none passes: each end continues into at most one lane.
+  // Online the lanes near the vehicle (LanesThatMayHaveChanged), at the end of the drive all.
+  const bool online = settled_before_frame != std::numeric_limits<std::size_t>::max();
   while (true) {
+    std::vector<std::size_t> among;
+    if (online) {
+      among = LanesThatMayHaveChanged();
+    } else {
+      among.resize(lanes.size());
+      for (std::size_t i = 0; i < among.size(); ++i) among[i] = i;
+    }
     double best_cost = -1.0;
     std::size_t best_a = 0, best_b = 0;
-    for (std::size_t a = 0; a < lanes.size(); ++a) {
-      for (std::size_t b = 0; b < lanes.size(); ++b) {
+    for (std::size_t a : among) {
+      for (std::size_t b : among) {
         if (a == b || lanes[a].class_id != lanes[b].class_id) continue;
         // The junction's data (first's end, second's start) must have left the windows.
         if (std::max(lanes[a].last_frame, lanes[b].first_frame) >= settled_before_frame) continue;

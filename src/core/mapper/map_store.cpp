@@ -58,13 +58,91 @@ void PruneBefore(std::size_t frame, Element* e) {
   e->pruned += n;
 }
 
+// The key of integer cell (ix, iy).
+std::int64_t CellKeyOf(std::int64_t ix, std::int64_t iy) {
+  return static_cast<std::int64_t>((static_cast<std::uint64_t>(ix) << 32) ^
+                                   (static_cast<std::uint64_t>(iy) & 0xffffffffULL));
+}
+
+std::int64_t CellIndexOf(double coordinate, double cell_m) {
+  return static_cast<std::int64_t>(std::floor(coordinate / cell_m));
+}
+
 }  // namespace
 
 MapStore::CellKey MapStore::RetiredCellOf(const Eigen::Vector3d& p_map) const {
-  const auto ix = static_cast<std::int64_t>(std::floor(p_map.x() / kRetiredCellM));
-  const auto iy = static_cast<std::int64_t>(std::floor(p_map.y() / kRetiredCellM));
-  return static_cast<CellKey>((static_cast<std::uint64_t>(ix) << 32) ^
-                              (static_cast<std::uint64_t>(iy) & 0xffffffffULL));
+  return CellKeyOf(CellIndexOf(p_map.x(), kRetiredCellM), CellIndexOf(p_map.y(), kRetiredCellM));
+}
+
+void MapStore::IndexLane(const LaneElement& lane, std::size_t first_changed) {
+  const std::vector<Eigen::Vector3d>& cps = lane.control_points_map;
+  auto note = [&](const Eigen::Vector2d& p) {
+    if (!p.allFinite()) return;
+    std::vector<std::uint64_t>& ids =
+        lane_cells_[CellKeyOf(CellIndexOf(p.x(), kLaneCellM), CellIndexOf(p.y(), kLaneCellM))];
+    if (std::find(ids.begin(), ids.end(), lane.id) == ids.end()) ids.push_back(lane.id);
+  };
+  // Each segment from the point before the first changed one, sampled at half a cell, so
+  // that a long segment (a join's bridge) lists the cells it crosses.
+  const std::size_t from = first_changed > 0 ? first_changed - 1 : 0;
+  for (std::size_t j = from; j < cps.size(); ++j) {
+    note(cps[j].head<2>());
+    if (j + 1 == cps.size()) break;
+    const Eigen::Vector2d d = (cps[j + 1] - cps[j]).head<2>();
+    const int steps = static_cast<int>(std::min(1e4, std::floor(d.norm() / (0.5 * kLaneCellM))));
+    for (int k = 1; k <= steps; ++k) note(cps[j].head<2>() + d * (k / (steps + 1.0)));
+  }
+}
+
+std::vector<std::size_t> MapStore::LanesNear(const Eigen::Vector3d& p_map, double radius_m) const {
+  std::vector<std::size_t> out;
+  if (map_.lanes.empty() || !(radius_m >= 0.0) || !p_map.allFinite()) return out;
+  const std::int64_t x0 = CellIndexOf(p_map.x() - radius_m, kLaneCellM);
+  const std::int64_t x1 = CellIndexOf(p_map.x() + radius_m, kLaneCellM);
+  const std::int64_t y0 = CellIndexOf(p_map.y() - radius_m, kLaneCellM);
+  const std::int64_t y1 = CellIndexOf(p_map.y() + radius_m, kLaneCellM);
+  // A disc of more cells than the index holds and than a query should visit (a huge
+  // radius): every lane, cheaper than its cells.
+  const double cells = (static_cast<double>(x1 - x0) + 1.0) * (static_cast<double>(y1 - y0) + 1.0);
+  if (!(cells <= std::max(kMaxLaneQueryCells, static_cast<double>(lane_cells_.size())))) {
+    out.resize(map_.lanes.size());
+    for (std::size_t i = 0; i < out.size(); ++i) out[i] = i;
+    return out;
+  }
+  bool rebuilt = false;
+  auto index_of = [&](std::uint64_t id, std::size_t* index) {
+    auto it = lane_index_by_id_.find(id);
+    if ((it == lane_index_by_id_.end() || it->second >= map_.lanes.size() ||
+         map_.lanes[it->second].id != id) &&
+        !rebuilt) {
+      lane_index_by_id_.clear();
+      for (std::size_t i = 0; i < map_.lanes.size(); ++i) lane_index_by_id_[map_.lanes[i].id] = i;
+      rebuilt = true;
+      it = lane_index_by_id_.find(id);
+    }
+    if (it == lane_index_by_id_.end() || map_.lanes[it->second].id != id) return false;
+    *index = it->second;
+    return true;
+  };
+  for (std::int64_t ix = x0; ix <= x1; ++ix) {
+    for (std::int64_t iy = y0; iy <= y1; ++iy) {
+      auto cell = lane_cells_.find(CellKeyOf(ix, iy));
+      if (cell == lane_cells_.end()) continue;
+      std::vector<std::uint64_t>& ids = cell->second;
+      for (std::size_t k = 0; k < ids.size();) {
+        std::size_t index = 0;
+        if (index_of(ids[k], &index)) {
+          out.push_back(index);
+          ++k;
+        } else {
+          ids.erase(ids.begin() + static_cast<std::ptrdiff_t>(k));  // the lane left the map
+        }
+      }
+    }
+  }
+  std::sort(out.begin(), out.end());
+  out.erase(std::unique(out.begin(), out.end()), out.end());
+  return out;
 }
 
 void MapStore::IndexRetired(std::size_t retired_index) {
@@ -156,6 +234,8 @@ void MapStore::Clear() {
   frame_index_.Clear();
   retired_cells_.clear();
   retired_index_by_id_.clear();
+  lane_cells_.clear();
+  lane_index_by_id_.clear();
   noted_marking_ids_.clear();
   noted_lane_ids_.clear();
   changes_.Clear();
@@ -178,6 +258,7 @@ void MapStore::Touch(LaneElement* lane, std::size_t first_changed) {
   lane->revision = changes_.Next();
   if (!lane->exported_at && lane->Exported()) lane->exported_at = lane->revision;
   changes_.NoteLane(lane->revision, lane->id, first_changed);
+  IndexLane(*lane, first_changed);
 }
 
 std::int64_t MapStore::RetiredIndexOf(std::uint64_t id) const {
@@ -206,7 +287,9 @@ void MapStore::NoteRemovals() {
 Eigen::Vector3d MapStore::RoadDirectionAt(const Eigen::Vector3d& p_map) const {
   double best = kRoadDirectionMaxDistanceM;
   Eigen::Vector3d tangent_map = Eigen::Vector3d::Zero();
-  for (const LaneElement& lane : map_.lanes) {
+  // ControlPointRangeNear's box about p_map, of half side max + 5 m: its corners bound it.
+  for (std::size_t i : LanesNear(p_map, std::sqrt(2.0) * (kRoadDirectionMaxDistanceM + 5.0))) {
+    const LaneElement& lane = map_.lanes[i];
     std::size_t first = 0, last = 0;  // the lane's part near p_map only
     if (!ControlPointRangeNear(lane.control_points_map, {p_map}, kRoadDirectionMaxDistanceM + 5.0,
                                &first, &last)) {

@@ -119,5 +119,12 @@ double LaneAssociationCost(const LaneElement& lane, const LaneCandidate& candida
 std::vector<int> AssociateLanes(const std::vector<LaneElement>& lanes,
                                 const std::vector<LaneCandidate>& candidates,
                                 const AssociationOptions& options);
+// The same among the lanes `among` (ascending indices into `lanes`, e.g. the lanes near the
+// frame); the result indexes `lanes`. The same result as above when `among` holds every lane
+// that can pass a candidate's gates.
+std::vector<int> AssociateLanes(const std::vector<LaneElement>& lanes,
+                                const std::vector<std::size_t>& among,
+                                const std::vector<LaneCandidate>& candidates,
+                                const AssociationOptions& options);
 
 }  // namespace ipm_road_mapper

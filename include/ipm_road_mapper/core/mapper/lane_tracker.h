@@ -56,10 +56,18 @@ class LaneTracker {
   std::size_t Grow(LaneElement* lane, std::size_t frame_index,
                    const std::vector<Eigen::Vector3d>& usable_map) const;
   void MergeLines();
+  // The margin about an observation's points within which a lane can explain it.
+  double AssociationMarginM() const;
+  // The lanes (ascending indices into the store's lanes) that can have changed since the
+  // last merge, and the lanes within a merge's or join's reach of them: those near the
+  // vehicle. A superset; a merge or join of two other lanes was decided before.
+  std::vector<std::size_t> LanesThatMayHaveChanged() const;
 
   const MapperOptions& options_;
   MapStore* store_;
   MapperCounters* counters_;
+  // The frame's lanes near its observations (Update), and the lanes it started.
+  std::vector<std::size_t> near_;
 };
 
 }  // namespace ipm_road_mapper

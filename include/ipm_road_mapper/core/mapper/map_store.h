@@ -1,6 +1,7 @@
 // The mapper's map: the frames it used (with a spatial index over their positions), the live
-// elements, the retired markings (with a spatial index over their centers, so that the front
-// end's per-frame work touches the live elements and a neighbourhood only), and the
+// elements, the retired markings (with a spatial index over their centers), the lanes (with
+// a spatial index over their control points), so that the front end's per-frame work touches
+// the live elements and a neighbourhood only, and the
 // road-geometry queries that the trackers and the window coordinator share (the road's
 // direction and surface at a point). It owns the data; the trackers and the coordinator
 // change it through the accessors.
@@ -95,6 +96,12 @@ class MapStore {
   const std::vector<MarkingElement>& retired_markings() const { return map_.retired_markings; }
   std::vector<LaneElement>& lanes() { return map_.lanes; }
   const std::vector<LaneElement>& lanes() const { return map_.lanes; }
+  // Indices into lanes(), ascending, of every lane with a control point within radius_m of
+  // p_map (x-y), and possibly a few more (a superset: the lanes of the grid cells the disc's
+  // square touches). Lanes are never retired, so a loop over lanes() costs the whole drive's
+  // lanes; a per-frame loop over these costs a neighbourhood. Every writer of a lane's
+  // control points calls Touch, which indexes them.
+  std::vector<std::size_t> LanesNear(const Eigen::Vector3d& p_map, double radius_m) const;
 
   // Unit tangent of the mapped lane nearest to p_map, within max_distance_m (8 m); zero when
   // there is none.
@@ -110,6 +117,8 @@ class MapStore {
   using CellKey = std::int64_t;
   CellKey RetiredCellOf(const Eigen::Vector3d& p_map) const;
   void IndexRetired(std::size_t retired_index);
+  // Lists `lane` in the lane cells of its control points from first_changed - 1 on.
+  void IndexLane(const LaneElement& lane, std::size_t first_changed);
 
   // Whether `marking` is an element of retired_markings().
   bool IsRetired(const MarkingElement* marking) const;
@@ -125,9 +134,16 @@ class MapStore {
   // Retired markings by the grid cell of their center (cells of kRetiredCellM).
   std::unordered_map<CellKey, std::vector<std::size_t>> retired_cells_;
   double max_retired_cov_trace_ = 0.0;
+  // Lane ids by the grid cell (kLaneCellM) of their control points. An id is never removed
+  // when its lane's points leave a cell (a superset), only when the lane has left the map
+  // (LanesNear drops it then); lane_index_by_id_ is rebuilt when an id is not where it says.
+  mutable std::unordered_map<CellKey, std::vector<std::uint64_t>> lane_cells_;
+  mutable std::unordered_map<std::uint64_t, std::size_t> lane_index_by_id_;
   Eigen::Isometry3d T_map_odom_ = Eigen::Isometry3d::Identity();
   std::int64_t corrected_frame_ = -1;  // the frame T_map_odom_ was taken from (-1: none)
   static constexpr double kRetiredCellM = 10.0;
+  static constexpr double kLaneCellM = 25.0;
+  static constexpr double kMaxLaneQueryCells = 4096.0;  // a disc of radius 800 m
 };
 
 }  // namespace ipm_road_mapper
