@@ -1,6 +1,7 @@
 // The lane tracker alone, on observations extracted from rendered masks: one dashed line is
 // one spline that grows as the vehicle drives, a short unmatched piece starts nothing, two
-// lanes along one line are merged, and the export re-fit follows a changed extrinsic.
+// lanes along one line are merged, a gap beyond join_max_gap_m is bridged only where no frame
+// saw it, and the export re-fit follows a changed extrinsic.
 #include <gtest/gtest.h>
 
 #include "common/lane_fragments.h"
@@ -181,6 +182,57 @@ TEST(LaneTracker, AtTheEndOrWithoutLaneResidualJunctionsJoinAtOnce) {
     rig.tracker.JoinFragments(rig.tracker.SettledBefore());
     EXPECT_EQ(rig.store.lanes().size(), 1u) << backend_enabled;
   }
+}
+
+// Two fragments of one line 30 m apart (beyond join_max_gap_m, within
+// join_max_hidden_gap_m), seen in frames 0-39 and 70-109 of a drive along x, heading `yaw`.
+void AddFarFragments(Rig* rig, double yaw) {
+  std::mt19937 rng(9);
+  const test::Line line = test::Straight(1.75);
+  AddLane(rig, test::MakeLane(rig->store.NewId(), 2, line, 0.0, 40.0, 0, 40, &rng));
+  AddLane(rig, test::MakeLane(rig->store.NewId(), 2, line, 70.0, 110.0, 70, 110, &rng));
+  for (std::size_t i = 0; i < 125; ++i) {
+    const Eigen::Isometry3d T_map_base = Eigen::Translation3d(static_cast<double>(i), 0.0, 0.0) *
+                                         Eigen::AngleAxisd(yaw, Eigen::Vector3d::UnitZ());
+    rig->store.AddFrame(0.05 * static_cast<double>(i), T_map_base);
+  }
+}
+
+TEST(LaneTracker, ALongGapIsJoinedOnlyWhereNoFrameSawIt) {
+  // The camera looks along the road: it saw the gap empty, the line ended there.
+  Rig seen;
+  AddFarFragments(&seen, 0.0);
+  seen.tracker.SetCamera(TestCamera(), TestExtrinsic());
+  seen.tracker.JoinFragments();
+  EXPECT_EQ(seen.store.lanes().size(), 2u);
+  // No camera known: the gap cannot be told hidden.
+  Rig unknown;
+  AddFarFragments(&unknown, -M_PI / 2);
+  unknown.tracker.JoinFragments();
+  EXPECT_EQ(unknown.store.lanes().size(), 2u);
+  // The camera looked away from the line (to the right of a line on the left) the whole
+  // time: the gap was hidden, so the fragments are one line, joined at the end of the drive
+  // (online, with every junction settled, they are left apart: no window ties to the bridge).
+  MapperOptions settled;
+  settled.backend.lane_residual = LaneResidual::kNone;
+  Rig hidden(settled);
+  AddFarFragments(&hidden, -M_PI / 2);
+  hidden.tracker.SetCamera(TestCamera(), TestExtrinsic());
+  ASSERT_EQ(hidden.tracker.SettledBefore(), 125u);
+  hidden.tracker.JoinFragments(hidden.tracker.SettledBefore());
+  EXPECT_EQ(hidden.store.lanes().size(), 2u);
+  hidden.tracker.JoinFragments();
+  ASSERT_EQ(hidden.store.lanes().size(), 1u);
+  EXPECT_EQ(hidden.counters.lanes_joined_hidden_gap, 1u);
+  EXPECT_EQ(hidden.store.lanes()[0].history.size(), 80u);
+  // Hidden, but longer than join_max_hidden_gap_m: apart.
+  MapperOptions short_reach;
+  short_reach.lanes.join.max_hidden_gap_m = 25.0;
+  Rig too_long(short_reach);
+  AddFarFragments(&too_long, -M_PI / 2);
+  too_long.tracker.SetCamera(TestCamera(), TestExtrinsic());
+  too_long.tracker.JoinFragments();
+  EXPECT_EQ(too_long.store.lanes().size(), 2u);
 }
 
 TEST(LaneTracker, AClassFlickeringBetweenDashedAndSolidMakesNoDuplicate) {

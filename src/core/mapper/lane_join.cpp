@@ -248,6 +248,26 @@ std::optional<PairAnalysis> Analyze(const LaneElement& first, const LaneElement&
   return a;
 }
 
+// `first` with `cps` as its control points and `second`'s history and span merged in.
+LaneElement Joined(const LaneElement& first, const LaneElement& second,
+                   std::vector<Eigen::Vector3d> cps) {
+  LaneElement joined = first;
+  joined.control_points_map = std::move(cps);
+  joined.history.insert(joined.history.end(), second.history.begin(), second.history.end());
+  std::sort(joined.history.begin(), joined.history.end(),
+            [](const LaneMeasurement& x, const LaneMeasurement& y) {
+              return x.frame_index < y.frame_index;
+            });
+  joined.pruned += second.pruned;
+  joined.first_frame = std::min(first.first_frame, second.first_frame);
+  joined.last_frame = std::max(first.last_frame, second.last_frame);
+  joined.first_seen = std::min(first.first_seen, second.first_seen);
+  joined.last_seen = std::max(first.last_seen, second.last_seen);
+  joined.optimized = first.optimized || second.optimized;
+  joined.retired_before_frame = std::min(first.retired_before_frame, second.retired_before_frame);
+  return joined;
+}
+
 }  // namespace
 
 bool CoObserved(const LaneElement& a, const LaneElement& b) { return SeenInOneFrame(a, b); }
@@ -313,21 +333,19 @@ std::optional<LaneElement> JoinLanes(const LaneElement& first, const LaneElement
   cps.push_back(2.0 * cps.back() - cps[cps.size() - 2]);
   if (cps.size() < 4) return std::nullopt;
 
-  LaneElement joined = first;
-  joined.control_points_map = std::move(cps);
-  joined.history.insert(joined.history.end(), second.history.begin(), second.history.end());
-  std::sort(joined.history.begin(), joined.history.end(),
-            [](const LaneMeasurement& x, const LaneMeasurement& y) {
-              return x.frame_index < y.frame_index;
-            });
-  joined.pruned += second.pruned;
-  joined.first_frame = std::min(first.first_frame, second.first_frame);
-  joined.last_frame = std::max(first.last_frame, second.last_frame);
-  joined.first_seen = std::min(first.first_seen, second.first_seen);
-  joined.last_seen = std::max(first.last_seen, second.last_seen);
-  joined.optimized = first.optimized || second.optimized;
-  joined.retired_before_frame = std::min(first.retired_before_frame, second.retired_before_frame);
-  return joined;
+  return Joined(first, second, std::move(cps));
+}
+
+std::optional<LaneElement> JoinLanesThrough(const LaneElement& first, const LaneElement& second,
+                                            const std::vector<Eigen::Vector3d>& bridge_map) {
+  const std::vector<Eigen::Vector3d>& cf = first.control_points_map;
+  const std::vector<Eigen::Vector3d>& cs = second.control_points_map;
+  if (cf.size() < 4 || cs.size() < 4) return std::nullopt;
+  std::vector<Eigen::Vector3d> cps(cf.begin(), cf.end() - 1);  // without first's end phantom
+  cps.insert(cps.end(), bridge_map.begin(), bridge_map.end());
+  cps.insert(cps.end(), cs.begin() + 1, cs.end() - 1);  // without second's start phantom
+  cps.push_back(2.0 * cps.back() - cps[cps.size() - 2]);
+  return Joined(first, second, std::move(cps));
 }
 
 }  // namespace ipm_road_mapper

@@ -311,7 +311,8 @@ std::vector<std::size_t> LaneTracker::LanesThatMayHaveChanged() const {
   }
   const LaneJoinOptions& join = options_.lanes.join;
   const double reach_m =
-      std::max(AssociationMarginM(), join.max_gap_m + join.max_overlap_m + 2.0 * join.end_length_m);
+      std::max(AssociationMarginM(), std::max(join.max_gap_m, join.max_hidden_gap_m) +
+                                         join.max_overlap_m + 2.0 * join.end_length_m);
   return store_->LanesNear(now, travel_m + options_.ipm.max_range_m + reach_m);
 }
 
@@ -320,57 +321,6 @@ std::size_t LaneTracker::SettledBefore() const {
   const BackendOptions& backend = options_.backend;
   if (!backend.enabled || backend.lane_residual == LaneResidual::kNone) return frames;
   return LaneContextStart(backend, frames);
-}
-
-void LaneTracker::JoinFragments(std::size_t settled_before_frame) {
-  const LaneJoinOptions& join = options_.lanes.join;
-  if (!join.enabled) return;
-  // Ends farther apart than this cannot be joined (a cheap test before the models).
-  const double reach_m = join.max_gap_m + join.max_overlap_m + 2.0 * join.end_length_m;
-  std::vector<LaneElement>& lanes = store_->lanes();
-  // The best pair first, until none passes: each end continues into at most one lane.
-  // Online the lanes near the vehicle (LanesThatMayHaveChanged), at the end of the drive all.
-  const bool online = settled_before_frame != std::numeric_limits<std::size_t>::max();
-  while (true) {
-    std::vector<std::size_t> among;
-    if (online) {
-      among = LanesThatMayHaveChanged();
-    } else {
-      among.resize(lanes.size());
-      for (std::size_t i = 0; i < among.size(); ++i) among[i] = i;
-    }
-    double best_cost = -1.0;
-    std::size_t best_a = 0, best_b = 0;
-    for (std::size_t a : among) {
-      for (std::size_t b : among) {
-        if (a == b || lanes[a].class_id != lanes[b].class_id) continue;
-        // The junction's data (first's end, second's start) must have left the windows.
-        if (std::max(lanes[a].last_frame, lanes[b].first_frame) >= settled_before_frame) continue;
-        const auto& ca = lanes[a].control_points_map;
-        const auto& cb = lanes[b].control_points_map;
-        if (ca.size() < 4 || cb.size() < 4 ||
-            (ca[ca.size() - 2] - cb[1]).head<2>().norm() > reach_m) {
-          continue;
-        }
-        const double cost = LaneJoinCost(lanes[a], lanes[b], join, options_.association);
-        if (cost >= 0.0 && (best_cost < 0.0 || cost < best_cost)) {
-          best_cost = cost;
-          best_a = a;
-          best_b = b;
-        }
-      }
-    }
-    if (best_cost < 0.0) return;
-    auto result = JoinLanes(lanes[best_a], lanes[best_b], join, options_.association,
-                            options_.lanes.fit.chord_spacing_m);
-    if (!result) return;  // degenerate: left apart (rare; the next merge tries again)
-    const auto changed_from =
-        FirstChangedControlPoint(lanes[best_a].control_points_map, result->control_points_map);
-    lanes[best_a] = std::move(*result);
-    store_->Touch(&lanes[best_a], changed_from);
-    lanes.erase(lanes.begin() + best_b);
-    ++counters_->lanes_joined;
-  }
 }
 
 void LaneTracker::DropSpurious(std::size_t frame_index) {

@@ -82,6 +82,7 @@ LaneOptions LoadLaneOptions(OptionsReader reader) {
   reader.Read<double>("min_new_lane_length_m", &o.min_new_lane_length_m, CheckNonNegative);
   reader.Read<bool>("join_enabled", &o.join.enabled);
   reader.Read<double>("join_max_gap_m", &o.join.max_gap_m, CheckNonNegative);
+  reader.Read<double>("join_max_hidden_gap_m", &o.join.max_hidden_gap_m, CheckNonNegative);
   reader.Read<double>("join_max_overlap_m", &o.join.max_overlap_m, CheckNonNegative);
   reader.Read<double>("join_end_length_m", &o.join.end_length_m, CheckPositive);
   reader.Read<double>("join_gate_sigmas", &o.join.gate_sigmas, CheckPositive);

@@ -11,6 +11,7 @@
 #pragma once
 
 #include <optional>
+#include <vector>
 
 #include "ipm_road_mapper/core/frontend/association.h"
 #include "ipm_road_mapper/core/map/road_map.h"
@@ -22,7 +23,11 @@ struct LaneJoinOptions {
   // On by default: one spline per painted line. Online, a junction is joined once its data
   // has left the windows (LaneTracker::JoinFragments; docs/backend.md, "Joining fragments").
   bool enabled = true;
-  double max_gap_m = 20.0;      // longest gap between A's last data and B's first
+  double max_gap_m = 20.0;  // longest gap between A's last data and B's first
+  // Longest gap (along the driven path) that is joined when no frame saw it at a usable range
+  // and both ends keep one offset from the path (a line hidden from the view,
+  // lane_gap_visibility.h, lane_path_bridge.h; LaneTracker::JoinFragments); 0: never.
+  double max_hidden_gap_m = 40.0;
   double max_overlap_m = 10.0;  // longest stretch where both have data
   double end_length_m = 20.0;   // each end is modelled by its data within this length
   double gate_sigmas = 3.0;     // offset and direction agreement, in combined sigmas
@@ -52,6 +57,12 @@ double LaneJoinCost(const LaneElement& first, const LaneElement& second,
 std::optional<LaneElement> JoinLanes(const LaneElement& first, const LaneElement& second,
                                      const LaneJoinOptions& join, const AssociationOptions& options,
                                      double chord_spacing_m);
+
+// `first` and `second` joined through `bridge_map` (points from first's end to second's
+// start, e.g. BridgeAlongPath): first's control points, the bridge, second's; the rest as
+// JoinLanes. Nullopt when either lane has fewer than 4 control points.
+std::optional<LaneElement> JoinLanesThrough(const LaneElement& first, const LaneElement& second,
+                                            const std::vector<Eigen::Vector3d>& bridge_map);
 
 // Whether the two lanes have a measurement of one frame each (histories sorted by frame).
 bool CoObserved(const LaneElement& a, const LaneElement& b);

@@ -7,10 +7,13 @@
 #include <Eigen/Geometry>
 #include <cstddef>
 #include <limits>
+#include <optional>
 #include <vector>
 
 #include "ipm_road_mapper/core/frontend/observations.h"
 #include "ipm_road_mapper/core/geometry/pinhole_camera.h"
+#include "ipm_road_mapper/core/mapper/lane_gap_visibility.h"
+#include "ipm_road_mapper/core/mapper/lane_path_bridge.h"
 #include "ipm_road_mapper/core/mapper/map_store.h"
 #include "ipm_road_mapper/core/mapper/mapper_counters.h"
 #include "ipm_road_mapper/core/mapper/mapper_options.h"
@@ -26,12 +29,16 @@ class LaneTracker {
   // One frame: associates its lane observations, starts or grows lanes; every
   // lanes.merge_every_n_frames frames, merges lanes that are one line.
   void Update(const std::vector<LaneObservation>& observations, const FrameRecord& frame);
+  // The camera and extrinsic the frames are seen with, for the joins across a gap no frame
+  // saw (lane_gap_visibility.h); until it is set no such gap is joined.
+  void SetCamera(const CameraIntrinsics& camera, const Eigen::Isometry3d& T_base_cam);
   // Drops the lanes seen in one frame only and not again for
   // association.spurious_after_frames frames.
   void DropSpurious(std::size_t frame_index);
   // Joins the lanes that continue one another (LaneContinues), until none does; runs with
-  // the merge and at the end of the drive. Online only junctions whose data (the first's
-  // last and the second's first observation) is older than `settled_before_frame`: a join
+  // the merge and at the end of the drive, where it also joins across a gap no frame saw
+  // (JoinCost). Online only junctions whose data (the first's last and the second's first
+  // observation) is older than `settled_before_frame`: a join
   // inside the windows ties the data on both sides of a gap with the bridge's smoothness
   // while the windows still solve the poses and extrinsic around it, which moved the
   // extrinsic's lateral lever arm by 2 cm on public_road (docs/backend.md).
@@ -56,6 +63,17 @@ class LaneTracker {
   std::size_t Grow(LaneElement* lane, std::size_t frame_index,
                    const std::vector<Eigen::Vector3d>& usable_map) const;
   void MergeLines();
+  // The join cost of the pair (LaneJoinCost), or -1; `at_end` (the end of the drive) also
+  // with `*hidden` true when it passes only as a gap no frame saw, bridged along the driven
+  // path (lanes.join_max_hidden_gap_m, lane_path_bridge.h): the offsets' disagreement in
+  // combined floor sigmas. Such a bridge is measured by no pixel: joined online, the windows
+  // that later solve the rest of the lane moved curvy's extrinsic rotation 0.090 -> 0.099
+  // deg (docs/backend.md), so it is laid only when no window follows.
+  double JoinCost(const LaneElement& first, const LaneElement& second, bool at_end,
+                  bool* hidden) const;
+  // The path bridge of such a gap (frames around it), or nullopt.
+  std::optional<PathBridge> HiddenGapBridge(const LaneElement& first,
+                                            const LaneElement& second) const;
   // The margin about an observation's points within which a lane can explain it.
   double AssociationMarginM() const;
   // The lanes (ascending indices into the store's lanes) that can have changed since the
@@ -68,6 +86,7 @@ class LaneTracker {
   MapperCounters* counters_;
   // The frame's lanes near its observations (Update), and the lanes it started.
   std::vector<std::size_t> near_;
+  GapCamera gap_camera_;
 };
 
 }  // namespace ipm_road_mapper

@@ -24,6 +24,8 @@ struct MapperCounters {
   std::uint64_t markings_inconsistent = 0;  // markings unseen where they should be: dropped
   std::uint64_t lanes_merged = 0;
   std::uint64_t lanes_joined = 0;  // fragments of one line joined end to start (lane_join.h)
+  // ... of them across a gap longer than join_max_gap_m that no frame saw (lane_gap_visibility.h)
+  std::uint64_t lanes_joined_hidden_gap = 0;
   std::uint64_t markings_merged = 0;
   std::uint64_t lane_observations_unused = 0;  // unmatched and too short / unfit to start a lane
   // Unmatched but close to a lane of its class (within twice the gates): not a new line, so

@@ -1,0 +1,119 @@
+// The lane tracker's joins of a line's fragments (lane_join.h), and at the end of the drive
+// across a gap no frame saw (lane_gap_visibility.h, lane_path_bridge.h).
+#include <algorithm>
+#include <cmath>
+
+#include "ipm_road_mapper/core/frontend/association.h"
+#include "ipm_road_mapper/core/mapper/change_log.h"
+#include "ipm_road_mapper/core/mapper/lane_join.h"
+#include "ipm_road_mapper/core/mapper/lane_tracker.h"
+
+namespace ipm_road_mapper {
+
+void LaneTracker::JoinFragments(std::size_t settled_before_frame) {
+  const LaneJoinOptions& join = options_.lanes.join;
+  if (!join.enabled) return;
+  // Ends farther apart than this cannot be joined (a cheap test before the models).
+  const double reach_m = std::max(join.max_gap_m, join.max_hidden_gap_m) + join.max_overlap_m +
+                         2.0 * join.end_length_m;
+  std::vector<LaneElement>& lanes = store_->lanes();
+  // The best pair first, until none passes: each end continues into at most one lane.
+  // Online the lanes near the vehicle (LanesThatMayHaveChanged), at the end of the drive all.
+  const bool online = settled_before_frame != std::numeric_limits<std::size_t>::max();
+  while (true) {
+    std::vector<std::size_t> among;
+    if (online) {
+      among = LanesThatMayHaveChanged();
+    } else {
+      among.resize(lanes.size());
+      for (std::size_t i = 0; i < among.size(); ++i) among[i] = i;
+    }
+    double best_cost = -1.0;
+    std::size_t best_a = 0, best_b = 0;
+    bool best_hidden = false;
+    for (std::size_t a : among) {
+      for (std::size_t b : among) {
+        if (a == b || lanes[a].class_id != lanes[b].class_id) continue;
+        // The junction's data (first's end, second's start) must have left the windows.
+        if (std::max(lanes[a].last_frame, lanes[b].first_frame) >= settled_before_frame) continue;
+        const auto& ca = lanes[a].control_points_map;
+        const auto& cb = lanes[b].control_points_map;
+        if (ca.size() < 4 || cb.size() < 4 ||
+            (ca[ca.size() - 2] - cb[1]).head<2>().norm() > reach_m) {
+          continue;
+        }
+        bool hidden = false;
+        const double cost = JoinCost(lanes[a], lanes[b], !online, &hidden);
+        if (cost >= 0.0 && (best_cost < 0.0 || cost < best_cost)) {
+          best_cost = cost;
+          best_a = a;
+          best_b = b;
+          best_hidden = hidden;
+        }
+      }
+    }
+    if (best_cost < 0.0) return;
+    std::optional<LaneElement> result;
+    if (best_hidden) {
+      const std::optional<PathBridge> bridge = HiddenGapBridge(lanes[best_a], lanes[best_b]);
+      if (bridge) result = JoinLanesThrough(lanes[best_a], lanes[best_b], bridge->points);
+    } else {
+      result = JoinLanes(lanes[best_a], lanes[best_b], join, options_.association,
+                         options_.lanes.fit.chord_spacing_m);
+    }
+    if (!result) return;  // degenerate: left apart (rare; the next merge tries again)
+    const auto changed_from =
+        FirstChangedControlPoint(lanes[best_a].control_points_map, result->control_points_map);
+    lanes[best_a] = std::move(*result);
+    store_->Touch(&lanes[best_a], changed_from);
+    lanes.erase(lanes.begin() + best_b);
+    ++counters_->lanes_joined;
+    if (best_hidden) ++counters_->lanes_joined_hidden_gap;
+  }
+}
+
+void LaneTracker::SetCamera(const CameraIntrinsics& camera, const Eigen::Isometry3d& T_base_cam) {
+  gap_camera_.camera = PinholeCamera(camera);
+  gap_camera_.T_base_cam = T_base_cam;
+  gap_camera_.error_model = options_.ipm.error_model;
+}
+
+double LaneTracker::JoinCost(const LaneElement& first, const LaneElement& second, bool at_end,
+                             bool* hidden) const {
+  *hidden = false;
+  const LaneJoinOptions& join = options_.lanes.join;
+  const double cost = LaneJoinCost(first, second, join, options_.association);
+  if (cost >= 0.0 || !at_end || join.max_hidden_gap_m <= 0.0 || first.class_id != second.class_id ||
+      CoObserved(first, second)) {
+    return cost;
+  }
+  // A gap the ordinary join does not bridge: along the driven path, if no frame saw it.
+  const std::optional<PathBridge> bridge = HiddenGapBridge(first, second);
+  if (!bridge) return -1.0;
+  // The two ends' offsets from the path agree within their combined floor sigma.
+  const double sigma = std::sqrt(2.0) * LaneFloorSigma(options_.association);
+  const double path_cost = std::abs(bridge->offset_change_m) / sigma;
+  if (path_cost > join.gate_sigmas) return -1.0;
+  GapViewOptions view;
+  view.max_point_score_m2 = options_.association.lane_max_point_score_m2;
+  view.max_range_m = options_.ipm.max_range_m;
+  view.border_margin_px = options_.extraction.border_margin_px;
+  const std::vector<FrameRecord>& frames = store_->frames();
+  const FrameSpan span =
+      GapFrameSpan(frames, first.last_frame, second.first_frame, options_.ipm.max_range_m);
+  if (FramesThatSawGap(bridge->points, frames, span, gap_camera_, view) > 0) return -1.0;
+  *hidden = true;
+  return path_cost;
+}
+
+std::optional<PathBridge> LaneTracker::HiddenGapBridge(const LaneElement& first,
+                                                       const LaneElement& second) const {
+  const std::vector<FrameRecord>& frames = store_->frames();
+  const FrameSpan span =
+      GapFrameSpan(frames, first.last_frame, second.first_frame, options_.ipm.max_range_m);
+  const double spacing_m = options_.lanes.fit.chord_spacing_m;
+  return BridgeAlongPath(first, second, frames, span, options_.lanes.join.max_hidden_gap_m,
+                         spacing_m, spacing_m);
+}
+
+}  // namespace ipm_road_mapper
