@@ -42,22 +42,6 @@ struct EndModel {
   double Slope(double x) const { return coeff.y() + 2.0 * coeff.z() * x; }
 };
 
-// Horizontal direction of a lane at its end (at_end) or start, over about `length_m`.
-Eigen::Vector2d EndDirection(const std::vector<Eigen::Vector3d>& cps, bool at_end,
-                             double length_m) {
-  const int n = static_cast<int>(cps.size());
-  const int end = at_end ? n - 2 : 1;
-  const int step = at_end ? -1 : 1;
-  int other = end + step;
-  while (other + step >= 1 && other + step <= n - 2 &&
-         (cps[other].head<2>() - cps[end].head<2>()).norm() < length_m) {
-    other += step;
-  }
-  Eigen::Vector2d d =
-      at_end ? (cps[end] - cps[other]).head<2>().eval() : (cps[other] - cps[end]).head<2>().eval();
-  return d.norm() > 1e-9 ? d.normalized() : Eigen::Vector2d::Zero();
-}
-
 // The mean lateral IPM variance (across the pair frame's x axis, Omega_p) of the kept
 // selected points of one measurement (indices into its selected points). Omega_p is in
 // base_link: the frame's yaw (map <- base) is read from the selected points in base_link
@@ -218,8 +202,8 @@ std::optional<PairAnalysis> Analyze(const LaneElement& first, const LaneElement&
     return std::nullopt;
   }
   // The directions at the very ends (a chord): over longer stretches an arc turns too much.
-  const Eigen::Vector2d t_first = EndDirection(first.control_points_map, true, 0.0);
-  const Eigen::Vector2d t_second = EndDirection(second.control_points_map, false, 0.0);
+  const Eigen::Vector2d t_first = LaneEndDirection(first.control_points_map, true, 0.0);
+  const Eigen::Vector2d t_second = LaneEndDirection(second.control_points_map, false, 0.0);
   if (t_first.dot(t_second) < kMinDirectionCos) return std::nullopt;
   PairAnalysis a;
   a.frame.origin = first.control_points_map[first.control_points_map.size() - 2].head<2>();
@@ -248,27 +232,46 @@ std::optional<PairAnalysis> Analyze(const LaneElement& first, const LaneElement&
   return a;
 }
 
-// `first` with `cps` as its control points and `second`'s history and span merged in.
+// `first` with `cps` as its control points and `second`'s observations merged in.
 LaneElement Joined(const LaneElement& first, const LaneElement& second,
                    std::vector<Eigen::Vector3d> cps) {
   LaneElement joined = first;
   joined.control_points_map = std::move(cps);
-  joined.history.insert(joined.history.end(), second.history.begin(), second.history.end());
-  std::sort(joined.history.begin(), joined.history.end(),
-            [](const LaneMeasurement& x, const LaneMeasurement& y) {
-              return x.frame_index < y.frame_index;
-            });
-  joined.pruned += second.pruned;
-  joined.first_frame = std::min(first.first_frame, second.first_frame);
-  joined.last_frame = std::max(first.last_frame, second.last_frame);
-  joined.first_seen = std::min(first.first_seen, second.first_seen);
-  joined.last_seen = std::max(first.last_seen, second.last_seen);
+  MergeObservations(second, &joined);
   joined.optimized = first.optimized || second.optimized;
   joined.retired_before_frame = std::min(first.retired_before_frame, second.retired_before_frame);
   return joined;
 }
 
 }  // namespace
+
+Eigen::Vector2d LaneEndDirection(const std::vector<Eigen::Vector3d>& cps, bool at_end,
+                                 double length_m) {
+  const int n = static_cast<int>(cps.size());
+  const int end = at_end ? n - 2 : 1;
+  const int step = at_end ? -1 : 1;
+  int other = end + step;
+  while (other + step >= 1 && other + step <= n - 2 &&
+         (cps[other].head<2>() - cps[end].head<2>()).norm() < length_m) {
+    other += step;
+  }
+  Eigen::Vector2d d =
+      at_end ? (cps[end] - cps[other]).head<2>().eval() : (cps[other] - cps[end]).head<2>().eval();
+  return d.norm() > 1e-9 ? d.normalized() : Eigen::Vector2d::Zero();
+}
+
+void MergeObservations(const LaneElement& other, LaneElement* lane) {
+  lane->history.insert(lane->history.end(), other.history.begin(), other.history.end());
+  std::sort(lane->history.begin(), lane->history.end(),
+            [](const LaneMeasurement& x, const LaneMeasurement& y) {
+              return x.frame_index < y.frame_index;
+            });
+  lane->pruned += other.pruned;
+  lane->first_frame = std::min(lane->first_frame, other.first_frame);
+  lane->last_frame = std::max(lane->last_frame, other.last_frame);
+  lane->first_seen = std::min(lane->first_seen, other.first_seen);
+  lane->last_seen = std::max(lane->last_seen, other.last_seen);
+}
 
 bool CoObserved(const LaneElement& a, const LaneElement& b) { return SeenInOneFrame(a, b); }
 

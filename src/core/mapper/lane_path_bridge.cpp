@@ -3,6 +3,8 @@
 #include <algorithm>
 #include <cmath>
 
+#include "ipm_road_mapper/core/mapper/lane_join.h"
+
 namespace ipm_road_mapper {
 namespace {
 
@@ -13,7 +15,7 @@ constexpr std::size_t kMaxSpanFrames = 6000;
 // An end runs along the path when its direction is within this of the path's (30 deg, the
 // join's kMinDirectionCos).
 constexpr double kMinAlongPathCos = 0.87;
-// An end's direction: over its last this many meters of control points.
+// An end's direction: over its last this many meters of control points (LaneEndDirection).
 constexpr double kEndDirectionLengthM = 6.0;
 
 struct PathPlace {
@@ -54,19 +56,6 @@ Eigen::Vector2d OffsetPoint(const std::vector<Eigen::Vector2d>& path,
   return path[i] + (s - s_at[i]) * u + offset * Eigen::Vector2d(-u.y(), u.x());
 }
 
-// The horizontal direction of the lane at its end (at_end) or start, pointing along it.
-Eigen::Vector2d EndDirection(const std::vector<Eigen::Vector3d>& cps, bool at_end) {
-  const int n = static_cast<int>(cps.size());
-  const int end = at_end ? n - 2 : 1, step = at_end ? -1 : 1;
-  int other = end + step;
-  while (other + step >= 1 && other + step <= n - 2 &&
-         (cps[other].head<2>() - cps[end].head<2>()).norm() < kEndDirectionLengthM) {
-    other += step;
-  }
-  const Eigen::Vector2d d = (at_end ? cps[end] - cps[other] : cps[other] - cps[end]).head<2>();
-  return d.norm() > 1e-9 ? d.normalized() : Eigen::Vector2d::Zero();
-}
-
 }  // namespace
 
 std::optional<PathBridge> BridgeAlongPath(const LaneElement& first, const LaneElement& second,
@@ -97,8 +86,8 @@ std::optional<PathBridge> BridgeAlongPath(const LaneElement& first, const LaneEl
   bridge.gap_m = b->s - a->s;
   bridge.offset_change_m = b->offset - a->offset;
   if (bridge.gap_m <= 0.0 || bridge.gap_m > max_gap_m ||
-      EndDirection(cf, true).dot(a->tangent) < kMinAlongPathCos ||
-      EndDirection(cs, false).dot(b->tangent) < kMinAlongPathCos) {
+      LaneEndDirection(cf, true, kEndDirectionLengthM).dot(a->tangent) < kMinAlongPathCos ||
+      LaneEndDirection(cs, false, kEndDirectionLengthM).dot(b->tangent) < kMinAlongPathCos) {
     return std::nullopt;
   }
   for (double s = a->s + inset_m; s <= b->s - inset_m + 1e-9; s += spacing_m) {

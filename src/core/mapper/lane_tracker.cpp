@@ -7,6 +7,7 @@
 #include "ipm_road_mapper/core/geometry/ipm.h"
 #include "ipm_road_mapper/core/geometry/lane_end_fit.h"
 #include "ipm_road_mapper/core/geometry/spline_fitting.h"
+#include "ipm_road_mapper/core/mapper/lane_join.h"
 #include "ipm_road_mapper/core/mapper/path_curvature.h"
 #include "ipm_road_mapper/core/mapper/window_coordinator.h"
 
@@ -258,16 +259,7 @@ void LaneTracker::MergeLines() {
         ++bi;
         continue;
       }
-      first.history.insert(first.history.end(), second.history.begin(), second.history.end());
-      std::sort(first.history.begin(), first.history.end(),
-                [](const LaneMeasurement& x, const LaneMeasurement& y) {
-                  return x.frame_index < y.frame_index;
-                });
-      first.pruned += second.pruned;
-      first.first_frame = std::min(first.first_frame, second.first_frame);
-      first.last_frame = std::max(first.last_frame, second.last_frame);
-      first.first_seen = std::min(first.first_seen, second.first_seen);
-      first.last_seen = std::max(first.last_seen, second.last_seen);
+      MergeObservations(second, &first);
       // Grow `first` over the second's stretch; its own control points keep their indices.
       std::vector<Eigen::Vector3d> points;
       for (const LaneMeasurement& m : second.history) {
@@ -311,8 +303,7 @@ std::vector<std::size_t> LaneTracker::LanesThatMayHaveChanged() const {
   }
   const LaneJoinOptions& join = options_.lanes.join;
   const double reach_m =
-      std::max(AssociationMarginM(), std::max(join.max_gap_m, join.max_hidden_gap_m) +
-                                         join.max_overlap_m + 2.0 * join.end_length_m);
+      std::max(AssociationMarginM(), join.max_gap_m + join.max_overlap_m + 2.0 * join.end_length_m);
   return store_->LanesNear(now, travel_m + options_.ipm.max_range_m + reach_m);
 }
 

@@ -13,13 +13,15 @@ namespace ipm_road_mapper {
 void LaneTracker::JoinFragments(std::size_t settled_before_frame) {
   const LaneJoinOptions& join = options_.lanes.join;
   if (!join.enabled) return;
-  // Ends farther apart than this cannot be joined (a cheap test before the models).
-  const double reach_m = std::max(join.max_gap_m, join.max_hidden_gap_m) + join.max_overlap_m +
-                         2.0 * join.end_length_m;
-  std::vector<LaneElement>& lanes = store_->lanes();
   // The best pair first, until none passes: each end continues into at most one lane.
   // Online the lanes near the vehicle (LanesThatMayHaveChanged), at the end of the drive all.
   const bool online = settled_before_frame != std::numeric_limits<std::size_t>::max();
+  // Ends farther apart than this cannot be joined (a cheap test before the models); a hidden
+  // gap (JoinCost) is joined at the end of the drive only.
+  const double max_gap_m =
+      online ? join.max_gap_m : std::max(join.max_gap_m, join.max_hidden_gap_m);
+  const double reach_m = max_gap_m + join.max_overlap_m + 2.0 * join.end_length_m;
+  std::vector<LaneElement>& lanes = store_->lanes();
   while (true) {
     std::vector<std::size_t> among;
     if (online) {
@@ -55,7 +57,8 @@ void LaneTracker::JoinFragments(std::size_t settled_before_frame) {
     if (best_cost < 0.0) return;
     std::optional<LaneElement> result;
     if (best_hidden) {
-      const std::optional<PathBridge> bridge = HiddenGapBridge(lanes[best_a], lanes[best_b]);
+      const std::optional<PathBridge> bridge =
+          HiddenGapBridge(lanes[best_a], lanes[best_b], GapSpan(lanes[best_a], lanes[best_b]));
       if (bridge) result = JoinLanesThrough(lanes[best_a], lanes[best_b], bridge->points);
     } else {
       result = JoinLanes(lanes[best_a], lanes[best_b], join, options_.association,
@@ -88,7 +91,8 @@ double LaneTracker::JoinCost(const LaneElement& first, const LaneElement& second
     return cost;
   }
   // A gap the ordinary join does not bridge: along the driven path, if no frame saw it.
-  const std::optional<PathBridge> bridge = HiddenGapBridge(first, second);
+  const FrameSpan span = GapSpan(first, second);
+  const std::optional<PathBridge> bridge = HiddenGapBridge(first, second, span);
   if (!bridge) return -1.0;
   // The two ends' offsets from the path agree within their combined floor sigma.
   const double sigma = std::sqrt(2.0) * LaneFloorSigma(options_.association);
@@ -98,22 +102,22 @@ double LaneTracker::JoinCost(const LaneElement& first, const LaneElement& second
   view.max_point_score_m2 = options_.association.lane_max_point_score_m2;
   view.max_range_m = options_.ipm.max_range_m;
   view.border_margin_px = options_.extraction.border_margin_px;
-  const std::vector<FrameRecord>& frames = store_->frames();
-  const FrameSpan span =
-      GapFrameSpan(frames, first.last_frame, second.first_frame, options_.ipm.max_range_m);
-  if (FramesThatSawGap(bridge->points, frames, span, gap_camera_, view) > 0) return -1.0;
+  if (FramesThatSawGap(bridge->points, store_->frames(), span, gap_camera_, view) > 0) return -1.0;
   *hidden = true;
   return path_cost;
 }
 
+FrameSpan LaneTracker::GapSpan(const LaneElement& first, const LaneElement& second) const {
+  return GapFrameSpan(store_->frames(), first.last_frame, second.first_frame,
+                      options_.ipm.max_range_m);
+}
+
 std::optional<PathBridge> LaneTracker::HiddenGapBridge(const LaneElement& first,
-                                                       const LaneElement& second) const {
-  const std::vector<FrameRecord>& frames = store_->frames();
-  const FrameSpan span =
-      GapFrameSpan(frames, first.last_frame, second.first_frame, options_.ipm.max_range_m);
+                                                       const LaneElement& second,
+                                                       const FrameSpan& span) const {
   const double spacing_m = options_.lanes.fit.chord_spacing_m;
-  return BridgeAlongPath(first, second, frames, span, options_.lanes.join.max_hidden_gap_m,
-                         spacing_m, spacing_m);
+  return BridgeAlongPath(first, second, store_->frames(), span,
+                         options_.lanes.join.max_hidden_gap_m, spacing_m, spacing_m);
 }
 
 }  // namespace ipm_road_mapper

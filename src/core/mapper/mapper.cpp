@@ -131,7 +131,6 @@ FrameStatus Mapper::ProcessFrame(const FrameInput& input, std::string* reason) {
 
   const FrameRecord& frame = store_.AddFrame(input.stamp, input.T_map_base_odom, ground_base);
   markings_.Update(ipm, frame, &observations.markings);
-  lanes_.SetCamera(input.camera, windows_.T_base_cam());
   lanes_.Update(observations.lanes, frame);
   markings_.DropSpurious(frame.index);
   lanes_.DropSpurious(frame.index);
@@ -176,6 +175,7 @@ void Mapper::Reset() {
 
 bool Mapper::Finish(double time_budget_s) {
   const bool finished = windows_.Finish(time_budget_s);
+  // The camera for the joins across a gap no frame saw (those are joined here only).
   if (counters_.frames_used > 0) lanes_.SetCamera(windows_.camera(), windows_.T_base_cam());
   lanes_.JoinFragments();  // fragments the drive's last frames left apart
   store_.NoteRemovals();

@@ -64,6 +64,16 @@ std::optional<LaneElement> JoinLanes(const LaneElement& first, const LaneElement
 std::optional<LaneElement> JoinLanesThrough(const LaneElement& first, const LaneElement& second,
                                             const std::vector<Eigen::Vector3d>& bridge_map);
 
+// Horizontal direction of a lane at its end (at_end) or start, pointing along the lane,
+// from its last (first) interior control point to the one about `length_m` before (after)
+// it (0: the adjacent one); zero when degenerate.
+Eigen::Vector2d LaneEndDirection(const std::vector<Eigen::Vector3d>& control_points_map,
+                                 bool at_end, double length_m);
+
+// `other`'s observations merged into `lane`: histories by frame, pruned counts, the frame and
+// stamp spans (a merge or a join; control points are the caller's).
+void MergeObservations(const LaneElement& other, LaneElement* lane);
+
 // Whether the two lanes have a measurement of one frame each (histories sorted by frame).
 bool CoObserved(const LaneElement& a, const LaneElement& b);
 

@@ -30,7 +30,8 @@ class LaneTracker {
   // lanes.merge_every_n_frames frames, merges lanes that are one line.
   void Update(const std::vector<LaneObservation>& observations, const FrameRecord& frame);
   // The camera and extrinsic the frames are seen with, for the joins across a gap no frame
-  // saw (lane_gap_visibility.h); until it is set no such gap is joined.
+  // saw at the end of the drive (lane_gap_visibility.h); until it is set no such gap is
+  // joined.
   void SetCamera(const CameraIntrinsics& camera, const Eigen::Isometry3d& T_base_cam);
   // Drops the lanes seen in one frame only and not again for
   // association.spurious_after_frames frames.
@@ -71,9 +72,11 @@ class LaneTracker {
   // deg (docs/backend.md), so it is laid only when no window follows.
   double JoinCost(const LaneElement& first, const LaneElement& second, bool at_end,
                   bool* hidden) const;
-  // The path bridge of such a gap (frames around it), or nullopt.
-  std::optional<PathBridge> HiddenGapBridge(const LaneElement& first,
-                                            const LaneElement& second) const;
+  // The frames around the gap between the first's end and the second's start (GapFrameSpan),
+  // and the path bridge over it (BridgeAlongPath), or nullopt.
+  FrameSpan GapSpan(const LaneElement& first, const LaneElement& second) const;
+  std::optional<PathBridge> HiddenGapBridge(const LaneElement& first, const LaneElement& second,
+                                            const FrameSpan& span) const;
   // The margin about an observation's points within which a lane can explain it.
   double AssociationMarginM() const;
   // The lanes (ascending indices into the store's lanes) that can have changed since the
