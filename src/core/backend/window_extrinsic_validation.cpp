@@ -19,7 +19,7 @@ namespace {
 // there when the halves agreed.
 constexpr double kCandidateInformationRatio = 1.0;
 
-// A translation shift smaller than this many of its sigmas is not told from the rough value's
+// A lever-arm shift smaller than this many of its sigmas is not told from the rough value's
 // error (a two-sided test at about 95 %; HoldInsignificantTranslation).
 constexpr double kMinTranslationShiftSigmas = 2.0;
 
@@ -84,7 +84,7 @@ int HoldInsignificantTranslation(double min_shift_sigmas, ExtrinsicObservability
   const Matrix6d covariance = observability->basis_whitened * inverse.asDiagonal() *
                               observability->basis_whitened.transpose();
   int held = 0;
-  for (int i = 3; i <= 5; ++i) {
+  for (int i = 3; i <= 4; ++i) {  // x, y; never the height alone (header)
     if ((*w)(i) == 0.0 || std::abs((*w)(i)) >= min_shift_sigmas * std::sqrt(covariance(i, i)))
       continue;
     (*w)(i) = 0.0;
