@@ -50,14 +50,21 @@ TEST(BackendOptions, BadRobustKernelIsAnOptionsErrorNamingTheKey) {
             0u);
 }
 
-TEST(BackendOptions, JointStepIsOffByDefaultAndValidated) {
-  EXPECT_EQ(LoadFrom("{}").final_global_joint_iterations, 0);
-  EXPECT_EQ(LoadFrom("{final_global_joint_iterations: 50}").final_global_joint_iterations, 50);
-  EXPECT_NE(ToString(LoadFrom("{final_global_joint_iterations: 50}"))
-                .find("backend.final_global_joint_iterations: 50\n"),
-            std::string::npos);
+TEST(BackendOptions, TheGlobalSolveJointStepAndStartAreReadAndValidated) {
+  const BackendOptions defaults = LoadFrom("{}");
+  EXPECT_EQ(defaults.final_global_joint_iterations, 50);
+  EXPECT_TRUE(defaults.final_global_from_mounting);
+  EXPECT_EQ(LoadFrom("{final_global_joint_iterations: 0}").final_global_joint_iterations, 0);
+  EXPECT_FALSE(LoadFrom("{final_global_from_mounting: false}").final_global_from_mounting);
+  const std::string text = ToString(LoadFrom("{final_global_joint_iterations: 7}"));
+  EXPECT_NE(text.find("backend.final_global_joint_iterations: 7\n"), std::string::npos);
+  EXPECT_NE(text.find("backend.final_global_from_mounting: true\n"), std::string::npos);
   EXPECT_EQ(ErrorOf([] { LoadFrom("{final_global_joint_iterations: -1}"); }),
             "backend.final_global_joint_iterations: must be >= 0");
+  EXPECT_EQ(ErrorOf([] {
+              LoadFrom("{final_global_from_mounting: 3}");
+            }).rfind("backend.final_global_from_mounting: wrong type", 0),
+            0u);
 }
 
 TEST(BackendOptions, GatesKeepTheirFormerDefaults) {

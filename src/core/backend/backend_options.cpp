@@ -139,6 +139,7 @@ BackendOptions LoadBackendOptions(OptionsReader reader) {
                    &o.final_global_min_measurements_per_marking, CheckPositiveInt);
   reader.Read<int>("final_global_joint_iterations", &o.final_global_joint_iterations,
                    [](const int& v) { return v >= 0 ? "" : "must be >= 0"; });
+  reader.Read<bool>("final_global_from_mounting", &o.final_global_from_mounting);
   reader.RejectUnknownKeys();
   return o;
 }
@@ -209,7 +210,8 @@ std::string ToString(const BackendOptions& o) {
     << k
     << "final_global_min_measurements_per_marking: " << o.final_global_min_measurements_per_marking
     << "\n"
-    << k << "final_global_joint_iterations: " << o.final_global_joint_iterations << "\n";
+    << k << "final_global_joint_iterations: " << o.final_global_joint_iterations << "\n"
+    << k << "final_global_from_mounting: " << Bool(o.final_global_from_mounting) << "\n";
   return s.str();
 }
 

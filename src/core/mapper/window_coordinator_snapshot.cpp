@@ -24,7 +24,10 @@ void WindowCoordinator::FinalGlobalSolve(double time_budget_s) {
   WindowSnapshot snapshot;
   snapshot.sequence = next_sequence_++;
   snapshot.camera = camera_;
-  snapshot.T_base_cam = T_base_cam_;
+  // The batch estimate starts at its prior's center: where the windows left the extrinsic
+  // depends on their path (which window result came when), and a solve from there stays in
+  // that path's valley (docs/backend.md, "Where the global solve starts").
+  snapshot.T_base_cam = o.final_global_from_mounting ? T_base_cam_initial_ : T_base_cam_;
   snapshot.extrinsic_prior =
       ExtrinsicPrior(T_base_cam_initial_, o.rotation_prior_sigma_rad, o.translation_prior_sigma_m);
   snapshot.newest_pose_covariance = false;  // the windows' covariance stands

@@ -130,8 +130,13 @@ struct BackendOptions {
   int final_global_min_measurements_per_marking = 30;
   // After its rounds, the global solve's joint step (window_joint_step.h): map, extrinsic
   // (its lever arm x, y held) and poses free in one problem, at most this many iterations;
-  // 0 = off (docs/backend.md, "The joint step": it trades between drives, opt-in).
-  int final_global_joint_iterations = 0;
+  // 0 = off (docs/backend.md, "The joint step").
+  int final_global_joint_iterations = 50;
+  // true: the global solve's extrinsic starts at the mounting value (the center of its
+  // prior, input.extrinsic), not where the windows left it. The batch estimate of the drive's
+  // calibration then does not inherit the online path's (docs/backend.md, "Where the global
+  // solve starts"); its map and poses still start from the windows'.
+  bool final_global_from_mounting = true;
 };
 
 // Reads the `backend` section; throws OptionsError naming the bad key.
