@@ -158,6 +158,28 @@ TEST(WindowCoordinator, MarkingsRetireAndTheFinalSolveRuns) {
   EXPECT_EQ(rig.counters.results_applied, applied + 2);
 }
 
+TEST(WindowCoordinator, TheGlobalSolveStartsAtTheMountingExtrinsic) {
+  // The windows refine the extrinsic along their path; the drive's batch solve starts at its
+  // prior's center, the mounting value, unless told to start where the windows left it.
+  MapperOptions options = SynchronousOptions();
+  Rig rig(options);
+  for (int k = 0; k < 80; ++k) rig.Step(DriftingFrame(k));
+  rig.windows.ApplyResults();
+  ASSERT_FALSE(rig.windows.T_base_cam().isApprox(TestExtrinsic(), 1e-9));
+  const WindowSnapshot global = rig.windows.BuildGlobalSnapshot();
+  EXPECT_TRUE(global.T_base_cam.isApprox(TestExtrinsic(), 1e-12));
+  EXPECT_TRUE(global.extrinsic_prior.DeltaOf(TestExtrinsic()).isZero(1e-12));
+  EXPECT_TRUE(global.cross_validate_extrinsic);
+  EXPECT_EQ(global.joint_step_iterations, options.backend.final_global_joint_iterations);
+
+  options.backend.final_global_from_mounting = false;
+  Rig from_windows(options);
+  for (int k = 0; k < 80; ++k) from_windows.Step(DriftingFrame(k));
+  from_windows.windows.ApplyResults();
+  EXPECT_TRUE(from_windows.windows.BuildGlobalSnapshot().T_base_cam.isApprox(
+      from_windows.windows.T_base_cam(), 1e-12));
+}
+
 TEST(WindowCoordinator, FinishKeepsItsTimeBudget) {
   MapperOptions options = SynchronousOptions();
   options.backend.synchronous = false;  // a real optimizer thread, as on a vehicle

@@ -12,8 +12,27 @@ namespace ipm_road_mapper {
 
 void WindowCoordinator::FinalGlobalSolve(double time_budget_s) {
   const BackendOptions& o = options_.backend;
+  if (!o.final_global_solve || store_->frames().empty()) return;
+  if (!(time_budget_s > 0.0)) return;
+  BackendOptions global = o;
+  global.rounds = o.final_global_rounds;
+  global.max_measurements_per_marking =
+      std::max(o.max_measurements_per_marking, o.final_global_min_measurements_per_marking);
+  global.max_extrinsic_change_rad = 1e9;  // the trust bound guards windows, not this
+  global.max_extrinsic_change_m = 1e9;
+  const WindowResult result = SolveWindow(BuildGlobalSnapshot(), global, time_budget_s);
+  if (!result.usable) {
+    ++counters_->results_rejected;
+    return;
+  }
+  ApplyResult(result, /*include_retired=*/true);
+  store_->ReindexRetiredMarkings();  // their corners moved
+  ++counters_->results_applied;
+}
+
+WindowSnapshot WindowCoordinator::BuildGlobalSnapshot() {
+  const BackendOptions& o = options_.backend;
   const std::vector<FrameRecord>& frames = store_->frames();
-  if (!o.final_global_solve || frames.empty()) return;
   // Everything at once over the last final_global_max_frames frames (all of a shorter
   // drive): those frames free, every marking that reached the back end and every lane with
   // their observations in that span, the extrinsic with the mounting prior alone (all the
@@ -68,21 +87,7 @@ void WindowCoordinator::FinalGlobalSolve(double time_budget_s) {
     snapshot.frames.push_back(
         {f.index, f.T_map_base, f.T_map_base_odom, true, f.stamp, false, f.ground_base});
   }
-  BackendOptions global = o;
-  global.rounds = o.final_global_rounds;
-  global.max_measurements_per_marking =
-      std::max(o.max_measurements_per_marking, o.final_global_min_measurements_per_marking);
-  global.max_extrinsic_change_rad = 1e9;  // the trust bound guards windows, not this
-  global.max_extrinsic_change_m = 1e9;
-  if (!(time_budget_s > 0.0)) return;
-  const WindowResult result = SolveWindow(snapshot, global, time_budget_s);
-  if (!result.usable) {
-    ++counters_->results_rejected;
-    return;
-  }
-  ApplyResult(result, /*include_retired=*/true);
-  store_->ReindexRetiredMarkings();  // their corners moved
-  ++counters_->results_applied;
+  return snapshot;
 }
 
 WindowSnapshot WindowCoordinator::BuildSnapshot() {

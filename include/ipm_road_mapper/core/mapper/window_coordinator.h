@@ -66,6 +66,12 @@ class WindowCoordinator {
   PoseCovariance PoseCovarianceOf(std::size_t index) const;
   // The camera of the last used frame (the snapshots', and the export re-fit's).
   const CameraIntrinsics& camera() const { return camera_; }
+  // What the final global solve solves (Finish): the last backend.final_global_max_frames
+  // frames free, every marking that reached the back end (retired ones too) and every lane
+  // with their observations in that span, the extrinsic under the mounting prior alone and
+  // started at the mounting value (backend.final_global_from_mounting) or where the windows
+  // left it. Takes a sequence number.
+  WindowSnapshot BuildGlobalSnapshot();
 
  private:
   // The first frame of the current window.
