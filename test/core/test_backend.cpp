@@ -216,6 +216,20 @@ TEST(SolveWindow, GuardKeepsTheExtrinsicWhenHeldOutFramesDisagree) {
   EXPECT_GT(RotationAngleBetween(unguarded.T_base_cam, scene.T_base_cam_true), 0.3 * kDeg);
 }
 
+TEST(SolveWindow, ACrossValidationOutOfTimeLeavesTheResultUnused) {
+  // The final solve's validation re-solves halves from the solved state; with no time left
+  // they would stop where they start and confirm every direction. Such a result must not be
+  // applied (it was, before: usable, every direction "confirmed").
+  Scene scene = MakeScene(0.0, 1);
+  scene.snapshot.cross_validate_extrinsic = true;
+  const BackendOptions options = SyncOptions();
+  const WindowResult late = SolveWindow(scene.snapshot, options, 1e-9);
+  EXPECT_FALSE(late.usable);
+  EXPECT_NE(late.reason.find("not cross-validated"), std::string::npos) << late.reason;
+  const WindowResult in_time = SolveWindow(scene.snapshot, options);
+  EXPECT_TRUE(in_time.usable) << in_time.reason;
+}
+
 TEST(SolveWindow, PoseStepPullsNoisyPosesTowardTheTruth) {
   // The pose step in isolation: extrinsic known and held, markings initialized from the
   // noisy poses; alternating map and pose steps must bring the poses closer to the truth.

@@ -92,9 +92,18 @@ WindowResult SolveWindow(const WindowSnapshot& snapshot, const BackendOptions& o
       }
     }
   }
+  // A refined extrinsic of the drive is used only once cross-validated. Halves that run out
+  // of time stop at (or near) the solved state they start from and agree with it by
+  // construction, so a validation begun or ended past the budget proves nothing: the result
+  // is not usable, and what the windows made stands.
+  bool validation_timed_out = false;
   if (snapshot.cross_validate_extrinsic && options.optimize_extrinsic && usable) {
-    result.extrinsic_directions_reverted =
-        CrossValidateExtrinsic(snapshot, options, remaining_s(), &state);
+    if (remaining_s() > 0.0) {
+      result.extrinsic_directions_reverted =
+          CrossValidateExtrinsic(snapshot, options, remaining_s(), &state);
+    }
+    validation_timed_out = !(remaining_s() > 0.0);
+    usable = !validation_timed_out;
   }
   FillCalibration(snapshot, state, &result);
 
@@ -102,7 +111,9 @@ WindowResult SolveWindow(const WindowSnapshot& snapshot, const BackendOptions& o
   result.extrinsic_change_rad = RotationAngleBetween(result.T_base_cam, snapshot.T_base_cam);
   result.extrinsic_change_m =
       (result.T_base_cam.translation() - snapshot.T_base_cam.translation()).norm();
-  if (!usable) {
+  if (validation_timed_out) {
+    result.reason = "out of time: the refined extrinsic was not cross-validated";
+  } else if (!usable) {
     result.reason = "solver: " + result.summary;
   } else if (result.extrinsic_change_rad > options.max_extrinsic_change_rad ||
              result.extrinsic_change_m > options.max_extrinsic_change_m) {
