@@ -9,6 +9,7 @@
 // (stop after this many masks), IRM_LONG_OUT (where the map is saved).
 #include <gtest/gtest.h>
 #include <nav_msgs/Odometry.h>
+#include <ros/time.h>
 #include <rosbag/bag.h>
 #include <rosbag/view.h>
 #include <sensor_msgs/CameraInfo.h>
@@ -36,6 +37,7 @@ double Seconds(Clock::duration d) { return std::chrono::duration<double>(d).coun
 TEST(LongDriveUnload, FinishesAndSavesWithinTheBudget) {
   const char* bag_path = std::getenv("IRM_LONG_BAG");
   if (!bag_path) GTEST_SKIP() << "set IRM_LONG_BAG=<drive.bag> (a long drive) to measure";
+  ros::Time::init();  // no node here: the worker's diagnostics stamp with ros::Time::now()
   const std::size_t max_frames =
       std::getenv("IRM_LONG_FRAMES") ? std::stoul(std::getenv("IRM_LONG_FRAMES")) : 0;
   const std::string out =
