@@ -160,6 +160,34 @@ TEST(AssociateLanes, PointsPastTheEndExtendTheLane) {
   EXPECT_EQ(far[0], -1);
 }
 
+TEST(LaneEndLineLength, TheLastChordAtTheDefaultNoiseTheWholeReachWhenTheNoiseSetsTheGate) {
+  AssociationOptions options;                  // 0.15 m of odometry noise
+  EXPECT_LT(LaneEndLineLength(options), 3.0);  // under one chord: the end tangent, as before
+  options.odometry_sigma_m = 0.5;              // 3 floor sigmas (1.51 m) exceed lane_gate_m (1.2 m)
+  EXPECT_NEAR(LaneEndLineLength(options), options.lane_max_end_gap_m, 1e-12);
+}
+
+TEST(AssociateLanes, PastACurledEndTheNeighboursLineIsNotTheLanesAtHighNoise) {
+  // Two dashed lines 3.5 m apart, both ending at x = 30 (a crossing where neither is
+  // painted). Lane 0's last control point is 0.5 m off toward lane 1, as the newest, least
+  // measured point is at 0.5 m of per-pose odometry noise: its last chord turns 9.5 deg
+  // toward lane 1, and 12 m past the end that chord's line is on lane 1's line. Beyond the
+  // crossing each line's observation continues its own lane.
+  LaneElement curled = StraightLane(2, 3.5, 0, 30);
+  const std::size_t n = curled.control_points_map.size();
+  curled.control_points_map[n - 2].y() -= 0.5;
+  curled.control_points_map[n - 1].y() -= 1.0;  // the phantom, 2 c_(n-2) - c_(n-3)
+  const std::vector<LaneElement> lanes = {curled, StraightLane(2, 0.0, 0, 30)};
+  AssociationOptions options;
+  options.odometry_sigma_m = 0.5;
+  const LaneCandidate lane1_beyond = LinePoints(2, 0.0, 40, 44);
+  const LaneCandidate lane0_beyond = LinePoints(2, 3.5, 40, 44);
+  EXPECT_LT(LaneAssociationCost(lanes[0], lane1_beyond, options), 0.0);
+  const std::vector<int> match = AssociateLanes(lanes, {lane1_beyond, lane0_beyond}, options);
+  EXPECT_EQ(match[0], 1);
+  EXPECT_EQ(match[1], 0);
+}
+
 TEST(AssociateLanes, RejectsCrossingDirection) {
   const std::vector<LaneElement> lanes = {StraightLane(2, 0.0, 0, 30)};
   LaneCandidate crossing;

@@ -9,6 +9,7 @@
 
 #include "ipm_road_mapper/core/frontend/partial_view_association.h"
 #include "ipm_road_mapper/core/geometry/catmull_rom_spline.h"
+#include "ipm_road_mapper/core/geometry/lane_end_line.h"
 
 namespace ipm_road_mapper {
 
@@ -144,6 +145,13 @@ double LaneFloorSigma(const AssociationOptions& options) {
   return std::hypot(options.lane_position_sigma_m, options.odometry_sigma_m);
 }
 
+double LaneEndLineLength(const AssociationOptions& options) {
+  const double gate_m =
+      std::max(options.lane_gate_m, options.lane_gate_sigmas * LaneFloorSigma(options));
+  const double noise_share = options.lane_gate_sigmas * LaneFloorSigma(options) / gate_m;
+  return options.lane_max_end_gap_m * noise_share * noise_share;
+}
+
 double MarkingAssociationCost(const MarkingElement& element, const MarkingCandidate& candidate,
                               const AssociationOptions& options) {
   // Compare in x-y: the mapped z of a marking is refined later, the gate is planar.
@@ -223,6 +231,9 @@ double LaneAssociationCost(const LaneElement& lane, const LaneCandidate& candida
     covs.push_back(candidate.cov_map.empty() ? Eigen::Matrix2d::Zero() : candidate.cov_map[i]);
   }
   if (points.size() < 2) return -1.0;
+  // The lines past the lane's ends, fitted on first use (most candidates reach neither).
+  std::optional<LaneEndLine> start_line, end_line;
+  const double end_line_length_m = LaneEndLineLength(options);
   const double floor = std::pow(LaneFloorSigma(options), 2);
   const double gate_m =
       std::max(options.lane_gate_m, options.lane_gate_sigmas * LaneFloorSigma(options));
@@ -266,15 +277,20 @@ double LaneAssociationCost(const LaneElement& lane, const LaneCandidate& candida
     Eigen::Vector2d tangent = spline.Derivative(closest.s).head<2>();
     if (tangent.norm() < 1e-9) continue;
     tangent.normalize();
-    const Eigen::Vector2d offset = (p - closest.point).head<2>();
-    const double along = offset.dot(tangent);
     const double end_s = spline.NumSegments();
-    const bool at_end =
-        (curve.has_start && closest.s <= 1e-6) || (curve.has_end && closest.s >= end_s - 1e-6);
-    if (at_end && std::abs(along) > options.lane_max_end_gap_m) continue;
-    // Past an end, the lateral distance is measured to the end tangent line.
-    const double lateral_m =
-        at_end ? std::abs(offset.x() * tangent.y() - offset.y() * tangent.x()) : offset.norm();
+    const bool past_start = curve.has_start && closest.s <= 1e-6;
+    const bool past_end = !past_start && curve.has_end && closest.s >= end_s - 1e-6;
+    double lateral_m = (p - closest.point).head<2>().norm();
+    if (past_start || past_end) {
+      // Past an end, the distance to the line the lane's last stretch continues along.
+      std::optional<LaneEndLine>& line = past_end ? end_line : start_line;
+      if (!line) line = FitLaneEndLine(lane.control_points_map, past_end, end_line_length_m);
+      if (!line->valid) continue;
+      double along = 0.0;
+      lateral_m = DistanceFromEndLine(*line, p, &along);
+      if (along > options.lane_max_end_gap_m) continue;
+      tangent = line->Direction();
+    }
     // The point's IPM variance across the lane (normal n of the tangent) plus the floor.
     const Eigen::Vector2d normal(-tangent.y(), tangent.x());
     const double variance = normal.dot(covs[i] * normal) + floor;

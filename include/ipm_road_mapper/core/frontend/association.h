@@ -56,6 +56,16 @@ struct AssociationOptions {
 double MarkingFloorSigma(const AssociationOptions& options);
 double LaneFloorSigma(const AssociationOptions& options);
 
+// The length of lane over which the line past an end is fitted (lane_end_line.h):
+// lane_max_end_gap_m times the square of the share of the lane gate that the floor noise
+// takes, (lane_gate_sigmas * LaneFloorSigma / gate)^2. At the default odometry noise
+// (share 0.4: 2.3 m) it is under the 3 m chord spacing, the last chord's line, the end
+// tangent; when the noise sets the gate (share 1: 0.4 m of noise and more) it is the whole
+// reach past the end, over which a curled end point barely turns the line. The square is
+// chosen on measured drives (docs/backend.md, "The end's line at high odometry noise"):
+// shorter lines split lanes at high noise, longer ones at the default noise on arcs.
+double LaneEndLineLength(const AssociationOptions& options);
+
 // Reads the `association` section; throws OptionsError naming the bad key.
 AssociationOptions LoadAssociationOptions(OptionsReader reader);
 
@@ -109,7 +119,9 @@ struct LaneCandidate {
 };
 
 // Cost of explaining `candidate` by `lane`: the median lateral distance in sigmas (the
-// point's lateral Omega_p plus lane_position_sigma_m^2); negative when the lane is not a
+// point's lateral Omega_p plus lane_position_sigma_m^2; past an end, up to
+// lane_max_end_gap_m, to the line fitted to the lane's last LaneEndLineLength, as is the
+// direction test there); negative when the lane is not a
 // candidate (class, direction, support, or either gate fails: lane_gate_sigmas on that
 // median, lane_gate_m on the median in meters).
 double LaneAssociationCost(const LaneElement& lane, const LaneCandidate& candidate,
