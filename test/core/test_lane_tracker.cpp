@@ -54,6 +54,27 @@ TEST(LaneTracker, OneDashedLineIsOneGrowingSpline) {
   EXPECT_EQ(rig.counters.lanes_created, 1u);
 }
 
+TEST(LaneTracker, OffsetAcrossIsTheFramesPoseErrorAsTheLanesSeeItAndChangesNothing) {
+  Rig rig;
+  for (int k = 0; k < 10; ++k) rig.Step(RoadFrame(100.0 + 0.05 * k, 1.0 * k, false));
+  ASSERT_EQ(rig.store.lanes().size(), 1u);
+  const std::vector<Eigen::Vector3d> before = rig.store.lanes()[0].control_points_map;
+  // The next frame at an odometry pose 0.3 m to the left of the truth: its line lands 0.3 m
+  // left of the lane, and 0.3 m to the right puts it back on.
+  FrameInput in = RoadFrame(100.5, 10.0, false);
+  std::optional<Ipm> ipm;
+  const FrameObservations obs = rig.Observe(in, TestExtrinsic(), &ipm);
+  in.T_map_base_odom.translation().y() += 0.3;
+  const FrameRecord& frame = rig.store.AddFrame(in.stamp, in.T_map_base_odom);
+  const std::optional<double> offset = rig.tracker.OffsetAcross(obs.lanes, frame);
+  ASSERT_TRUE(offset.has_value());
+  EXPECT_NEAR(*offset, -0.3, 0.05);
+  EXPECT_EQ(rig.store.lanes()[0].control_points_map, before);
+  EXPECT_EQ(rig.store.lanes()[0].history.size(), 10u);
+  // No lane observed: nothing to say.
+  EXPECT_FALSE(rig.tracker.OffsetAcross({}, frame).has_value());
+}
+
 TEST(LaneTracker, TwoLanesAlongOneLineAreMerged) {
   MapperOptions options;
   options.lanes.merge_every_n_frames = 1;

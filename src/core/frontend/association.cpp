@@ -310,6 +310,34 @@ double LaneAssociationCost(const LaneElement& lane, const LaneCandidate& candida
   return normalized[mid];
 }
 
+double LaneOffsetAcross(const LaneElement& lane, const LaneCandidate& candidate,
+                        const Eigen::Vector2d& left) {
+  std::vector<Eigen::Vector3d> points;
+  for (std::size_t i = 0; i < candidate.points_map.size(); ++i) {
+    if (!candidate.usable.empty() && !candidate.usable[i]) continue;
+    if (candidate.points_map[i].allFinite()) points.push_back(candidate.points_map[i]);
+  }
+  if (points.size() < 2 || lane.control_points_map.size() < 4) {
+    return std::numeric_limits<double>::quiet_NaN();
+  }
+  const std::optional<LocalCurve> curve = LocalCurveNear(lane.control_points_map, points, 5.0);
+  if (!curve) return std::numeric_limits<double>::quiet_NaN();
+  const double end_s = curve->spline.NumSegments();
+  const std::size_t step = std::max<std::size_t>(1, points.size() / 12);
+  std::vector<double> offsets;
+  for (std::size_t i = 0; i < points.size(); i += step) {
+    const CatmullRomSpline::ClosestPoint closest = curve->spline.FindClosest(points[i]);
+    if ((curve->has_start && closest.s <= 1e-6) || (curve->has_end && closest.s >= end_s - 1e-6)) {
+      continue;  // past an end: no offset across
+    }
+    offsets.push_back((closest.point - points[i]).head<2>().dot(left));
+  }
+  if (offsets.size() < 2) return std::numeric_limits<double>::quiet_NaN();
+  const std::size_t mid = offsets.size() / 2;
+  std::nth_element(offsets.begin(), offsets.begin() + mid, offsets.end());
+  return offsets[mid];
+}
+
 std::vector<int> AssociateLanes(const std::vector<LaneElement>& lanes,
                                 const std::vector<LaneCandidate>& candidates,
                                 const AssociationOptions& options) {

@@ -93,25 +93,52 @@ LaneCandidate SampledCandidate(const LaneElement& lane) {
 LaneTracker::LaneTracker(const MapperOptions& options, MapStore* store, MapperCounters* counters)
     : options_(options), store_(store), counters_(counters) {}
 
+LaneCandidate LaneTracker::CandidateOf(const LaneObservation& obs, const FrameRecord& frame) const {
+  const Eigen::Matrix2d R = frame.T_map_base.linear().topLeftCorner<2, 2>();
+  LaneCandidate candidate;
+  candidate.class_id = obs.class_id;
+  for (const LanePoint& point : obs.points) {
+    candidate.points_map.push_back(frame.T_map_base * point.p_base);
+    candidate.cov_map.push_back(R * point.cov_base * R.transpose());
+    candidate.usable.push_back(point.score <= options_.association.lane_max_point_score_m2);
+  }
+  return candidate;
+}
+
+std::optional<double> LaneTracker::OffsetAcross(const std::vector<LaneObservation>& observations,
+                                                const FrameRecord& frame) const {
+  std::vector<LaneCandidate> candidates;
+  for (const LaneObservation& obs : observations) candidates.push_back(CandidateOf(obs, frame));
+  const std::vector<LaneElement>& lanes = store_->lanes();
+  const std::vector<std::size_t> near = store_->LanesNear(
+      frame.T_map_base.translation(),
+      CandidateReach(candidates, frame.T_map_base.translation(), AssociationMarginM()));
+  const std::vector<int> match = AssociateLanes(lanes, near, candidates, options_.association);
+  const Eigen::Vector2d left = frame.T_map_base.linear().col(1).head<2>().normalized();
+  std::vector<double> offsets;
+  for (std::size_t c = 0; c < candidates.size(); ++c) {
+    if (match[c] < 0) continue;
+    const double offset = LaneOffsetAcross(lanes[match[c]], candidates[c], left);
+    if (std::isfinite(offset)) offsets.push_back(offset);
+  }
+  if (offsets.empty()) return std::nullopt;
+  const std::size_t mid = offsets.size() / 2;
+  std::nth_element(offsets.begin(), offsets.begin() + mid, offsets.end());
+  return offsets[mid];
+}
+
 void LaneTracker::Update(const std::vector<LaneObservation>& observations,
                          const FrameRecord& frame) {
   std::vector<LaneCandidate> candidates;
   std::vector<LaneMeasurement> measurements;
-  const Eigen::Matrix2d R = frame.T_map_base.linear().topLeftCorner<2, 2>();
   for (const LaneObservation& obs : observations) {
-    LaneCandidate candidate;
-    candidate.class_id = obs.class_id;
+    LaneCandidate candidate = CandidateOf(obs, frame);
     LaneMeasurement measurement;
     measurement.frame_index = frame.index;
     measurement.points = obs.points;
     measurement.selected = SelectPoints(obs.points, options_.lanes);
     for (std::size_t i = 0; i < obs.points.size(); ++i) {
-      const Eigen::Vector3d p_map = frame.T_map_base * obs.points[i].p_base;
-      candidate.points_map.push_back(p_map);
-      candidate.cov_map.push_back(R * obs.points[i].cov_base * R.transpose());
-      candidate.usable.push_back(obs.points[i].score <=
-                                 options_.association.lane_max_point_score_m2);
-      if (measurement.selected[i]) measurement.selected_map.push_back(p_map);
+      if (measurement.selected[i]) measurement.selected_map.push_back(candidate.points_map[i]);
     }
     candidates.push_back(std::move(candidate));
     measurements.push_back(std::move(measurement));

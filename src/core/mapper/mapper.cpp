@@ -5,6 +5,7 @@
 #include <cmath>
 #include <sstream>
 
+#include "ipm_road_mapper/core/frontend/frame_registration.h"
 #include "ipm_road_mapper/core/frontend/instance_extraction.h"
 #include "ipm_road_mapper/core/geometry/ipm.h"
 #include "ipm_road_mapper/core/geometry/trajectory_road_plane.h"
@@ -130,7 +131,13 @@ FrameStatus Mapper::ProcessFrame(const FrameInput& input, std::string* reason) {
   AppendBounded(&frontend_timing_.extraction_ms, elapsed_ms(start));
 
   const FrameRecord& frame = store_.AddFrame(input.stamp, input.T_map_base_odom, ground_base);
-  markings_.Update(ipm, frame, &observations.markings);
+  // Where the odometry's noise sets the gates, the markings are associated in the frame
+  // registered across the road by its lanes (frame_registration.h).
+  std::optional<double> offset_across_m;
+  if (NoiseSetsTheGates(options_.association)) {
+    offset_across_m = lanes_.OffsetAcross(observations.lanes, frame);
+  }
+  markings_.Update(ipm, frame, &observations.markings, offset_across_m);
   lanes_.Update(observations.lanes, frame);
   markings_.DropSpurious(frame.index);
   lanes_.DropSpurious(frame.index);

@@ -6,6 +6,7 @@
 #include <opencv2/imgproc.hpp>
 
 #include "ipm_road_mapper/core/frontend/association.h"
+#include "ipm_road_mapper/core/frontend/frame_registration.h"
 #include "ipm_road_mapper/core/frontend/instance_extraction.h"
 #include "ipm_road_mapper/core/mapper/marking_extent.h"
 #include "ipm_road_mapper/core/mapper/marking_pixel_agreement.h"
@@ -92,10 +93,11 @@ MarkingTracker::MarkingTracker(const MapperOptions& options, MapStore* store,
     : options_(options), store_(store), counters_(counters) {}
 
 void MarkingTracker::Update(const Ipm& ipm, const FrameRecord& frame,
-                            std::vector<MarkingObservation>* observations) {
+                            std::vector<MarkingObservation>* observations,
+                            std::optional<double> offset_across_m) {
   OrientAlongRoad(ipm, frame, observations);
 
-  Associate(*observations, frame);
+  Associate(*observations, frame, offset_across_m);
   CheckConsistency(ipm, frame);
   MergeDuplicates(ipm);
 }
@@ -123,7 +125,7 @@ void MarkingTracker::OrientAlongRoad(const Ipm& ipm, const FrameRecord& frame,
 }
 
 void MarkingTracker::Associate(const std::vector<MarkingObservation>& observations,
-                               const FrameRecord& frame) {
+                               const FrameRecord& frame, std::optional<double> offset_across_m) {
   std::vector<MarkingCandidate> candidates;
   candidates.reserve(observations.size());
   const Eigen::Matrix2d R = frame.T_map_base.linear().topLeftCorner<2, 2>();
@@ -157,7 +159,10 @@ void MarkingTracker::Associate(const std::vector<MarkingObservation>& observatio
   std::sort(retired_near.begin(), retired_near.end());
   retired_near.erase(std::unique(retired_near.begin(), retired_near.end()), retired_near.end());
   for (std::size_t i : retired_near) elements.push_back(&store_->retired_markings()[i]);
-  std::vector<int> match = AssociateMarkings(elements, candidates, options_.association);
+  // In the frame registered across the road by its lanes, where the noise sets the gates.
+  std::vector<int> match = AssociateMarkingsRegistered(
+      elements, candidates, options_.association,
+      frame.T_map_base.linear().col(0).head<2>().normalized(), offset_across_m);
   // Matched retired markings come back among the live ones (highest retired index first:
   // a revival moves the last retired marking into the freed place).
   const int live_count = static_cast<int>(markings.size());

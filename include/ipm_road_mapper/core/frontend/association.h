@@ -127,6 +127,13 @@ struct LaneCandidate {
 double LaneAssociationCost(const LaneElement& lane, const LaneCandidate& candidate,
                            const AssociationOptions& options);
 
+// The median signed distance (m) along `left` (unit, x-y) from the candidate's usable points
+// to the lane's curve, over the points beside the lane (not past its ends): how far the
+// frame's observation must move across to lie on the lane. NaN with fewer than two such
+// points.
+double LaneOffsetAcross(const LaneElement& lane, const LaneCandidate& candidate,
+                        const Eigen::Vector2d& left);
+
 // For each candidate, the index of its lane element or -1 (new element).
 std::vector<int> AssociateLanes(const std::vector<LaneElement>& lanes,
                                 const std::vector<LaneCandidate>& candidates,

@@ -33,6 +33,12 @@ class LaneTracker {
   // saw at the end of the drive (lane_gap_visibility.h); until it is set no such gap is
   // joined.
   void SetCamera(const CameraIntrinsics& camera, const Eigen::Isometry3d& T_base_cam);
+  // The offset (m) across the frame's heading that puts its lane observations on the lanes
+  // they would continue (AssociateLanes, without changing any lane; median over the lanes of
+  // LaneOffsetAcross), if any continues one: the frame's pose error across the road, as the
+  // map's lanes see it. For the markings' association (frame_registration.h).
+  std::optional<double> OffsetAcross(const std::vector<LaneObservation>& observations,
+                                     const FrameRecord& frame) const;
   // Drops the lanes seen in one frame only and not again for
   // association.spurious_after_frames frames.
   void DropSpurious(std::size_t frame_index);
@@ -77,6 +83,8 @@ class LaneTracker {
   FrameSpan GapSpan(const LaneElement& first, const LaneElement& second) const;
   std::optional<PathBridge> HiddenGapBridge(const LaneElement& first, const LaneElement& second,
                                             const FrameSpan& span) const;
+  // The observation in the map frame at the frame's pose, for association.
+  LaneCandidate CandidateOf(const LaneObservation& observation, const FrameRecord& frame) const;
   // The margin about an observation's points within which a lane can explain it.
   double AssociationMarginM() const;
   // The lanes (ascending indices into the store's lanes) that can have changed since the

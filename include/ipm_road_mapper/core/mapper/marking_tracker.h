@@ -6,6 +6,7 @@
 #pragma once
 
 #include <cstddef>
+#include <optional>
 #include <vector>
 
 #include "ipm_road_mapper/core/frontend/observations.h"
@@ -24,8 +25,12 @@ class MarkingTracker {
 
   // One frame: orients, associates, creates or extends elements, merges duplicates.
   // Observations whose re-oriented rectangle leaves the image are dropped (and counted).
+  // `offset_across_m`: the frame's pose error across its heading as the lanes measure it
+  // (LaneTracker::OffsetAcross), for association in the registered frame
+  // (frame_registration.h).
   void Update(const Ipm& ipm, const FrameRecord& frame,
-              std::vector<MarkingObservation>* observations);
+              std::vector<MarkingObservation>* observations,
+              std::optional<double> offset_across_m = std::nullopt);
   // Drops the elements seen in one frame only and not again for
   // association.spurious_after_frames frames, and the tentative ones that frames where they
   // should have been visible did not see (CheckConsistency).
@@ -37,7 +42,8 @@ class MarkingTracker {
   // heading is 5 deg off it on a 150 m curve 15 m ahead.
   void OrientAlongRoad(const Ipm& ipm, const FrameRecord& frame,
                        std::vector<MarkingObservation>* observations);
-  void Associate(const std::vector<MarkingObservation>& observations, const FrameRecord& frame);
+  void Associate(const std::vector<MarkingObservation>& observations, const FrameRecord& frame,
+                 std::optional<double> offset_across_m);
   // Counts, for each tentative live element, whether this frame should have seen it and
   // whether it did; confirms the consistent ones.
   void CheckConsistency(const Ipm& ipm, const FrameRecord& frame);
