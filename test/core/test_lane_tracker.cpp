@@ -66,13 +66,14 @@ TEST(LaneTracker, OffsetAcrossIsTheFramesPoseErrorAsTheLanesSeeItAndChangesNothi
   const FrameObservations obs = rig.Observe(in, TestExtrinsic(), &ipm);
   in.T_map_base_odom.translation().y() += 0.3;
   const FrameRecord& frame = rig.store.AddFrame(in.stamp, in.T_map_base_odom);
-  const std::optional<double> offset = rig.tracker.OffsetAcross(obs.lanes, frame);
+  const std::optional<double> offset =
+      rig.tracker.OffsetAcross(rig.tracker.Associate(obs.lanes, frame), frame);
   ASSERT_TRUE(offset.has_value());
   EXPECT_NEAR(*offset, -0.3, 0.05);
   EXPECT_EQ(rig.store.lanes()[0].control_points_map, before);
   EXPECT_EQ(rig.store.lanes()[0].history.size(), 10u);
   // No lane observed: nothing to say.
-  EXPECT_FALSE(rig.tracker.OffsetAcross({}, frame).has_value());
+  EXPECT_FALSE(rig.tracker.OffsetAcross(rig.tracker.Associate({}, frame), frame).has_value());
 }
 
 TEST(LaneTracker, TwoLanesAlongOneLineAreMerged) {

@@ -145,11 +145,17 @@ double LaneFloorSigma(const AssociationOptions& options) {
   return std::hypot(options.lane_position_sigma_m, options.odometry_sigma_m);
 }
 
+double LaneGateM(const AssociationOptions& options) {
+  return std::max(options.lane_gate_m, options.lane_gate_sigmas * LaneFloorSigma(options));
+}
+
+double LaneNoiseShare(const AssociationOptions& options) {
+  return options.lane_gate_sigmas * LaneFloorSigma(options) / LaneGateM(options);
+}
+
 double LaneEndLineLength(const AssociationOptions& options) {
-  const double gate_m =
-      std::max(options.lane_gate_m, options.lane_gate_sigmas * LaneFloorSigma(options));
-  const double noise_share = options.lane_gate_sigmas * LaneFloorSigma(options) / gate_m;
-  return options.lane_max_end_gap_m * noise_share * noise_share;
+  const double share = LaneNoiseShare(options);
+  return options.lane_max_end_gap_m * share * share;
 }
 
 double MarkingAssociationCost(const MarkingElement& element, const MarkingCandidate& candidate,
@@ -235,8 +241,7 @@ double LaneAssociationCost(const LaneElement& lane, const LaneCandidate& candida
   std::optional<LaneEndLine> start_line, end_line;
   const double end_line_length_m = LaneEndLineLength(options);
   const double floor = std::pow(LaneFloorSigma(options), 2);
-  const double gate_m =
-      std::max(options.lane_gate_m, options.lane_gate_sigmas * LaneFloorSigma(options));
+  const double gate_m = LaneGateM(options);
   // Only the part of the lane near the observation (a lane can be kilometers long); the
   // margin covers points past an end that still count. A candidate longer than an
   // observation (a whole lane, when lanes are merged) gets the part near each of its points,

@@ -4,9 +4,7 @@
 
 namespace ipm_road_mapper {
 
-bool NoiseSetsTheGates(const AssociationOptions& options) {
-  return options.lane_gate_sigmas * LaneFloorSigma(options) >= options.lane_gate_m;
-}
+bool NoiseSetsTheGates(const AssociationOptions& options) { return LaneNoiseShare(options) >= 1.0; }
 
 std::vector<int> AssociateMarkingsRegistered(const std::vector<const MarkingElement*>& elements,
                                              const std::vector<MarkingCandidate>& candidates,

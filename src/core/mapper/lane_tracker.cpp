@@ -93,32 +93,45 @@ LaneCandidate SampledCandidate(const LaneElement& lane) {
 LaneTracker::LaneTracker(const MapperOptions& options, MapStore* store, MapperCounters* counters)
     : options_(options), store_(store), counters_(counters) {}
 
-LaneCandidate LaneTracker::CandidateOf(const LaneObservation& obs, const FrameRecord& frame) const {
+LaneTracker::FrameAssociation LaneTracker::Associate(
+    const std::vector<LaneObservation>& observations, const FrameRecord& frame) const {
+  FrameAssociation a;
   const Eigen::Matrix2d R = frame.T_map_base.linear().topLeftCorner<2, 2>();
-  LaneCandidate candidate;
-  candidate.class_id = obs.class_id;
-  for (const LanePoint& point : obs.points) {
-    candidate.points_map.push_back(frame.T_map_base * point.p_base);
-    candidate.cov_map.push_back(R * point.cov_base * R.transpose());
-    candidate.usable.push_back(point.score <= options_.association.lane_max_point_score_m2);
+  for (const LaneObservation& obs : observations) {
+    LaneCandidate candidate;
+    candidate.class_id = obs.class_id;
+    LaneMeasurement measurement;
+    measurement.frame_index = frame.index;
+    measurement.points = obs.points;
+    measurement.selected = SelectPoints(obs.points, options_.lanes);
+    for (std::size_t i = 0; i < obs.points.size(); ++i) {
+      const Eigen::Vector3d p_map = frame.T_map_base * obs.points[i].p_base;
+      candidate.points_map.push_back(p_map);
+      candidate.cov_map.push_back(R * obs.points[i].cov_base * R.transpose());
+      candidate.usable.push_back(obs.points[i].score <=
+                                 options_.association.lane_max_point_score_m2);
+      if (measurement.selected[i]) measurement.selected_map.push_back(p_map);
+    }
+    a.candidates.push_back(std::move(candidate));
+    a.measurements.push_back(std::move(measurement));
   }
-  return candidate;
+  // Only the lanes within the candidates' reach (a neighbourhood, not the drive's lanes).
+  a.near = store_->LanesNear(
+      frame.T_map_base.translation(),
+      CandidateReach(a.candidates, frame.T_map_base.translation(), AssociationMarginM()));
+  a.match = AssociateLanes(store_->lanes(), a.near, a.candidates, options_.association);
+  return a;
 }
 
-std::optional<double> LaneTracker::OffsetAcross(const std::vector<LaneObservation>& observations,
+std::optional<double> LaneTracker::OffsetAcross(const FrameAssociation& association,
                                                 const FrameRecord& frame) const {
-  std::vector<LaneCandidate> candidates;
-  for (const LaneObservation& obs : observations) candidates.push_back(CandidateOf(obs, frame));
   const std::vector<LaneElement>& lanes = store_->lanes();
-  const std::vector<std::size_t> near = store_->LanesNear(
-      frame.T_map_base.translation(),
-      CandidateReach(candidates, frame.T_map_base.translation(), AssociationMarginM()));
-  const std::vector<int> match = AssociateLanes(lanes, near, candidates, options_.association);
   const Eigen::Vector2d left = frame.T_map_base.linear().col(1).head<2>().normalized();
   std::vector<double> offsets;
-  for (std::size_t c = 0; c < candidates.size(); ++c) {
-    if (match[c] < 0) continue;
-    const double offset = LaneOffsetAcross(lanes[match[c]], candidates[c], left);
+  for (std::size_t c = 0; c < association.candidates.size(); ++c) {
+    if (association.match[c] < 0) continue;
+    const double offset =
+        LaneOffsetAcross(lanes[association.match[c]], association.candidates[c], left);
     if (std::isfinite(offset)) offsets.push_back(offset);
   }
   if (offsets.empty()) return std::nullopt;
@@ -129,26 +142,15 @@ std::optional<double> LaneTracker::OffsetAcross(const std::vector<LaneObservatio
 
 void LaneTracker::Update(const std::vector<LaneObservation>& observations,
                          const FrameRecord& frame) {
-  std::vector<LaneCandidate> candidates;
-  std::vector<LaneMeasurement> measurements;
-  for (const LaneObservation& obs : observations) {
-    LaneCandidate candidate = CandidateOf(obs, frame);
-    LaneMeasurement measurement;
-    measurement.frame_index = frame.index;
-    measurement.points = obs.points;
-    measurement.selected = SelectPoints(obs.points, options_.lanes);
-    for (std::size_t i = 0; i < obs.points.size(); ++i) {
-      if (measurement.selected[i]) measurement.selected_map.push_back(candidate.points_map[i]);
-    }
-    candidates.push_back(std::move(candidate));
-    measurements.push_back(std::move(measurement));
-  }
+  Update(Associate(observations, frame), frame);
+}
+
+void LaneTracker::Update(FrameAssociation association, const FrameRecord& frame) {
+  std::vector<LaneCandidate>& candidates = association.candidates;
+  std::vector<LaneMeasurement>& measurements = association.measurements;
+  const std::vector<int>& match = association.match;
   std::vector<LaneElement>& lanes = store_->lanes();
-  // Only the lanes within the candidates' reach (a neighbourhood, not the drive's lanes).
-  near_ = store_->LanesNear(
-      frame.T_map_base.translation(),
-      CandidateReach(candidates, frame.T_map_base.translation(), AssociationMarginM()));
-  const std::vector<int> match = AssociateLanes(lanes, near_, candidates, options_.association);
+  near_ = std::move(association.near);
   for (std::size_t c = 0; c < candidates.size(); ++c) {
     // The start gate looks at every point of low enough uncertainty: the N best of PS alone
     // may all lie on the nearest dash of a dashed line, shorter than the gate.

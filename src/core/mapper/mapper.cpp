@@ -131,14 +131,16 @@ FrameStatus Mapper::ProcessFrame(const FrameInput& input, std::string* reason) {
   AppendBounded(&frontend_timing_.extraction_ms, elapsed_ms(start));
 
   const FrameRecord& frame = store_.AddFrame(input.stamp, input.T_map_base_odom, ground_base);
-  // Where the odometry's noise sets the gates, the markings are associated in the frame
-  // registered across the road by its lanes (frame_registration.h).
+  // The lanes' association first (the markings change no lane): where the odometry's noise
+  // sets the gates, the markings are associated in the frame registered across the road by
+  // it (frame_registration.h).
+  LaneTracker::FrameAssociation lane_association = lanes_.Associate(observations.lanes, frame);
   std::optional<double> offset_across_m;
   if (NoiseSetsTheGates(options_.association)) {
-    offset_across_m = lanes_.OffsetAcross(observations.lanes, frame);
+    offset_across_m = lanes_.OffsetAcross(lane_association, frame);
   }
   markings_.Update(ipm, frame, &observations.markings, offset_across_m);
-  lanes_.Update(observations.lanes, frame);
+  lanes_.Update(std::move(lane_association), frame);
   markings_.DropSpurious(frame.index);
   lanes_.DropSpurious(frame.index);
   PruneHistories();

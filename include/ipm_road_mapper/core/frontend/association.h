@@ -56,9 +56,15 @@ struct AssociationOptions {
 double MarkingFloorSigma(const AssociationOptions& options);
 double LaneFloorSigma(const AssociationOptions& options);
 
+// The lane gate (m): lane_gate_m, widened to lane_gate_sigmas floor sigmas when the
+// odometry is noisier than that.
+double LaneGateM(const AssociationOptions& options);
+// The share of the lane gate that the floor noise takes, lane_gate_sigmas * LaneFloorSigma /
+// LaneGateM, in (0, 1]: 1 where the odometry's noise sets the gate.
+double LaneNoiseShare(const AssociationOptions& options);
+
 // The length of lane over which the line past an end is fitted (lane_end_line.h):
-// lane_max_end_gap_m times the square of the share of the lane gate that the floor noise
-// takes, (lane_gate_sigmas * LaneFloorSigma / gate)^2. At the default odometry noise
+// lane_max_end_gap_m times the square of LaneNoiseShare. At the default odometry noise
 // (share 0.4: 2.3 m) it is under the 3 m chord spacing, the last chord's line, the end
 // tangent; when the noise sets the gate (share 1: 0.4 m of noise and more) it is the whole
 // reach past the end, over which a curled end point barely turns the line. The square is

@@ -31,8 +31,8 @@
 
 namespace ipm_road_mapper {
 
-// Whether the odometry's noise sets the lane gate (3 floor sigmas at least lane_gate_m:
-// about 0.4 m of per-pose noise and more).
+// Whether the odometry's noise sets the lane gate (LaneNoiseShare 1: 3 floor sigmas at
+// least lane_gate_m, about 0.4 m of per-pose noise and more).
 bool NoiseSetsTheGates(const AssociationOptions& options);
 
 // AssociateMarkings with the candidates moved by `offset_across_m` to the left of `heading`

@@ -26,18 +26,33 @@ class LaneTracker {
   // store and counters outlive the tracker.
   LaneTracker(const MapperOptions& options, MapStore* store, MapperCounters* counters);
 
+  // One frame's lane observations in the map frame and the lanes they continue, before any
+  // lane changes (Associate); what Update applies.
+  struct FrameAssociation {
+    std::vector<LaneCandidate> candidates;
+    std::vector<LaneMeasurement> measurements;
+    std::vector<std::size_t> near;  // the lanes within the candidates' reach
+    std::vector<int> match;         // per candidate: its lane's index, or -1
+  };
+
   // One frame: associates its lane observations, starts or grows lanes; every
   // lanes.merge_every_n_frames frames, merges lanes that are one line.
   void Update(const std::vector<LaneObservation>& observations, const FrameRecord& frame);
+  // The same in two steps, so that the association is also read before the lanes change
+  // (OffsetAcross): Update(Associate(o, f), f) is Update(o, f), as long as no lane changes
+  // between the two calls.
+  FrameAssociation Associate(const std::vector<LaneObservation>& observations,
+                             const FrameRecord& frame) const;
+  void Update(FrameAssociation association, const FrameRecord& frame);
   // The camera and extrinsic the frames are seen with, for the joins across a gap no frame
   // saw at the end of the drive (lane_gap_visibility.h); until it is set no such gap is
   // joined.
   void SetCamera(const CameraIntrinsics& camera, const Eigen::Isometry3d& T_base_cam);
   // The offset (m) across the frame's heading that puts its lane observations on the lanes
-  // they would continue (AssociateLanes, without changing any lane; median over the lanes of
-  // LaneOffsetAcross), if any continues one: the frame's pose error across the road, as the
-  // map's lanes see it. For the markings' association (frame_registration.h).
-  std::optional<double> OffsetAcross(const std::vector<LaneObservation>& observations,
+  // they continue (median over the lanes of LaneOffsetAcross), if any continues one: the
+  // frame's pose error across the road, as the map's lanes see it. For the markings'
+  // association (frame_registration.h).
+  std::optional<double> OffsetAcross(const FrameAssociation& association,
                                      const FrameRecord& frame) const;
   // Drops the lanes seen in one frame only and not again for
   // association.spurious_after_frames frames.
@@ -83,8 +98,6 @@ class LaneTracker {
   FrameSpan GapSpan(const LaneElement& first, const LaneElement& second) const;
   std::optional<PathBridge> HiddenGapBridge(const LaneElement& first, const LaneElement& second,
                                             const FrameSpan& span) const;
-  // The observation in the map frame at the frame's pose, for association.
-  LaneCandidate CandidateOf(const LaneObservation& observation, const FrameRecord& frame) const;
   // The margin about an observation's points within which a lane can explain it.
   double AssociationMarginM() const;
   // The lanes (ascending indices into the store's lanes) that can have changed since the
