@@ -1,6 +1,9 @@
 // Extrinsic (with its IPM grid error) and pose evaluation.
 #include <algorithm>
+#include <Eigen/Cholesky>
+#include <Eigen/Geometry>
 #include <cmath>
+#include <vector>
 
 #include "ipm_road_mapper/core/geometry/ipm.h"
 #include "ipm_road_mapper/eval/evaluation.h"
@@ -78,6 +81,40 @@ int NearestFrame(const GroundTruth& gt, const std::vector<int>& order, double st
 
 }  // namespace
 
+namespace {
+
+// The calibration's error over its reported covariance (ExtrinsicMetrics::err_sigmas,
+// nees_observed).
+void EvaluateCalibrationConsistency(const VectorMap& map, const Eigen::Isometry3d& T_true,
+                                    ExtrinsicMetrics* m) {
+  const Eigen::Matrix<double, 6, 6>& sigma = map.T_base_cam_covariance;
+  Eigen::Matrix<double, 6, 1> e;
+  const Eigen::AngleAxisd rotation_error(T_true.linear() * map.T_base_cam.linear().transpose());
+  e.head<3>() = rotation_error.angle() * rotation_error.axis();
+  e.tail<3>() = T_true.translation() - map.T_base_cam.translation();
+  for (int i = 0; i < 6; ++i) {
+    if (sigma(i, i) > 0.0) m->err_sigmas(i) = e(i) / std::sqrt(sigma(i, i));
+  }
+  std::vector<int> observed;
+  for (int i = 0; i < 6; ++i) {
+    if (map.T_base_cam_observed[i] && sigma(i, i) > 0.0) observed.push_back(i);
+  }
+  if (observed.empty()) return;
+  const int n = static_cast<int>(observed.size());
+  Eigen::MatrixXd sigma_oo(n, n);
+  Eigen::VectorXd e_o(n);
+  for (int r = 0; r < n; ++r) {
+    e_o(r) = e(observed[r]);
+    for (int c = 0; c < n; ++c) sigma_oo(r, c) = sigma(observed[r], observed[c]);
+  }
+  const Eigen::LDLT<Eigen::MatrixXd> ldlt(sigma_oo);
+  if (ldlt.info() != Eigen::Success || !ldlt.isPositive()) return;
+  m->nees_observed = e_o.dot(ldlt.solve(e_o));
+  m->nees_dof = n;
+}
+
+}  // namespace
+
 ExtrinsicMetrics EvaluateExtrinsic(const VectorMap& map, const GroundTruth& gt,
                                    const EvaluationOptions& options) {
   ExtrinsicMetrics m;
@@ -95,6 +132,7 @@ ExtrinsicMetrics EvaluateExtrinsic(const VectorMap& map, const GroundTruth& gt,
       IpmGridError(gt, map.T_base_cam, options, &m.ipm_grid_pixels, &m.ipm_grid_failed);
   m.ipm_grid_err_m_initial = IpmGridError(gt, map.T_base_cam_initial, options, &pixels_initial,
                                           &m.ipm_grid_failed_initial);
+  EvaluateCalibrationConsistency(map, T_true, &m);
   return m;
 }
 

@@ -136,6 +136,11 @@ void AddExtrinsic(const ExtrinsicMetrics& m, nlohmann::json* j) {
   (*j)["ipm_grid_pixels"] = m.ipm_grid_pixels;
   (*j)["ipm_grid_failed"] = m.ipm_grid_failed;
   (*j)["ipm_grid_failed_initial"] = m.ipm_grid_failed_initial;
+  nlohmann::json err_sigmas = nlohmann::json::array();
+  for (int i = 0; i < 6; ++i) err_sigmas.push_back(Number(m.err_sigmas(i)));
+  (*j)["extrinsic_err_sigmas"] = err_sigmas;
+  (*j)["extrinsic_nees_observed"] = Number(m.nees_observed);
+  (*j)["extrinsic_nees_dof"] = m.nees_dof;
 }
 
 void AddPoses(const PoseMetrics& m, nlohmann::json* j) {

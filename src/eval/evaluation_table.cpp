@@ -109,6 +109,13 @@ void AddExtrinsicRows(const Metrics& metrics, Table* t) {
          Fixed(e.ipm_grid_err_m.mean, 3), Fixed(e.ipm_grid_err_m_initial.mean, 3), "m");
   t->Row("IPM grid error max", Fixed(e.ipm_grid_err_m.max, 3),
          Fixed(e.ipm_grid_err_m_initial.max, 3), "m");
+  if (e.nees_dof > 0) {
+    std::string sigmas;
+    for (int i = 0; i < 6; ++i) sigmas += (i ? " " : "") + Fixed(e.err_sigmas(i), 1);
+    t->Row("error / its reported sigma (r p y x y z)", sigmas, "", "");
+    t->Row("NEES of the observed axes (" + std::to_string(e.nees_dof) + " dof)",
+           Fixed(e.nees_observed, 1), "", "");
+  }
   if (e.ipm_grid_failed + e.ipm_grid_failed_initial > 0) {
     t->Row("IPM grid pixels above the horizon", std::to_string(e.ipm_grid_failed),
            std::to_string(e.ipm_grid_failed_initial), "");

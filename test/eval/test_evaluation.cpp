@@ -283,6 +283,39 @@ TEST_F(EvaluationTest, ExtrinsicErrorIsTheAppliedRotationAndTranslation) {
   EXPECT_NEAR(pitch.rpy_err_deg.x(), 0.0, 1e-9);
 }
 
+TEST_F(EvaluationTest, CalibrationConsistencyIsTheErrorOverTheMapsOwnCovariance) {
+  // No covariance in the map: no consistency figure.
+  ExtrinsicMetrics m = EvaluateExtrinsic(map_, gt_, options_);
+  EXPECT_EQ(m.nees_dof, 0);
+  EXPECT_TRUE(std::isnan(m.nees_observed));
+  EXPECT_TRUE(std::isnan(m.err_sigmas(0)));
+
+  // 0.2 deg of yaw and 3 cm of height too high; the map claims 0.1 deg and 1 cm.
+  map_.T_base_cam = gt_.T_base_cam_true;
+  map_.T_base_cam.linear() = RotationFromRpy(0.0, 0.0, 0.2 * kDegToRad) * map_.T_base_cam.linear();
+  map_.T_base_cam.translation().z() += 0.03;
+  Eigen::Matrix<double, 6, 1> sigma;
+  sigma << 0.1 * kDegToRad, 0.1 * kDegToRad, 0.1 * kDegToRad, 0.05, 0.05, 0.01;
+  map_.T_base_cam_covariance = sigma.cwiseAbs2().asDiagonal();
+  map_.T_base_cam_observed = {true, true, true, false, false, true};
+  m = EvaluateExtrinsic(map_, gt_, options_);
+  // The covariance's error is the truth's side: R_true = Exp(e) R, t_true - t.
+  EXPECT_NEAR(m.err_sigmas(2), -2.0, 1e-6);
+  EXPECT_NEAR(m.err_sigmas(5), -3.0, 1e-9);
+  EXPECT_NEAR(m.err_sigmas(0), 0.0, 1e-6);
+  EXPECT_NEAR(m.err_sigmas(3), 0.0, 1e-12);
+  EXPECT_EQ(m.nees_dof, 4);
+  EXPECT_NEAR(m.nees_observed, 4.0 + 9.0, 1e-5);
+
+  // A correlation the error runs against raises the NEES; the diagonal sigmas stay.
+  map_.T_base_cam_covariance(2, 5) = map_.T_base_cam_covariance(5, 2) =
+      0.8 * sigma(2) * sigma(5);
+  m = EvaluateExtrinsic(map_, gt_, options_);
+  EXPECT_NEAR(m.err_sigmas(2), -2.0, 1e-6);
+  // [-2 -3] over [[1 .8] [.8 1]]: (4 + 9 - 2 * .8 * 6) / (1 - .64).
+  EXPECT_NEAR(m.nees_observed, (13.0 - 9.6) / 0.36, 1e-4);
+}
+
 TEST_F(EvaluationTest, PoseErrorIsTheAppliedShift) {
   for (StampedPose& pose : map_.trajectory) {
     pose.T_map_base.translation() += Eigen::Vector3d(0.2, -0.1, 0.0);

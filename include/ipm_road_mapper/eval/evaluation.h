@@ -155,6 +155,15 @@ struct ExtrinsicMetrics {
   int ipm_grid_pixels = 0;              // grid pixels in the 5-30 m band under the truth
   int ipm_grid_failed = 0;              // of those, above the horizon under the map's extrinsic
   int ipm_grid_failed_initial = 0;
+  // Whether the map's calibration is honest about itself: the error over the map's own
+  // covariance (VectorMap::T_base_cam_covariance). Per axis (roll, pitch, yaw, x, y, z; the
+  // rotation as the covariance defines it: R_true = Exp(e) R, about base_link's axes) the
+  // error in its reported sigmas, signed (NaN without a variance); and the NEES of the axes
+  // the map calls observed, e_o^T Sigma_oo^-1 e_o, chi-square with `nees_dof` degrees of
+  // freedom when the covariance is consistent (NaN when the map has no covariance).
+  Eigen::Matrix<double, 6, 1> err_sigmas = Eigen::Matrix<double, 6, 1>::Constant(kNoValue);
+  double nees_observed = kNoValue;
+  int nees_dof = 0;
 };
 
 // One pose of the map's trajectory matched to a GT frame.
