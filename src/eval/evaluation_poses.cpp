@@ -1,7 +1,7 @@
 // Extrinsic (with its IPM grid error) and pose evaluation.
-#include <algorithm>
 #include <Eigen/Cholesky>
 #include <Eigen/Geometry>
+#include <algorithm>
 #include <cmath>
 #include <vector>
 

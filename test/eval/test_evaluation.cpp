@@ -308,8 +308,7 @@ TEST_F(EvaluationTest, CalibrationConsistencyIsTheErrorOverTheMapsOwnCovariance)
   EXPECT_NEAR(m.nees_observed, 4.0 + 9.0, 1e-5);
 
   // A correlation the error runs against raises the NEES; the diagonal sigmas stay.
-  map_.T_base_cam_covariance(2, 5) = map_.T_base_cam_covariance(5, 2) =
-      0.8 * sigma(2) * sigma(5);
+  map_.T_base_cam_covariance(2, 5) = map_.T_base_cam_covariance(5, 2) = 0.8 * sigma(2) * sigma(5);
   m = EvaluateExtrinsic(map_, gt_, options_);
   EXPECT_NEAR(m.err_sigmas(2), -2.0, 1e-6);
   // [-2 -3] over [[1 .8] [.8 1]]: (4 + 9 - 2 * .8 * 6) / (1 - .64).
