@@ -42,7 +42,7 @@ bool Overlaps(double a0, double a1, double b0, double b1) { return a0 <= b1 && b
 void FillOccluders(const std::vector<OccluderOptions>& occluders, const RoadModel& road,
                    const Eigen::Isometry3d& T_cam_map, double s_cam, double t_s,
                    const FrustumProjector& projector, int value, int instance_class_id,
-                   cv::Mat* image) {
+                   cv::Mat* image, FillRule rule = FillRule::kOpenCvFillPoly) {
   std::vector<Eigen::Vector3d> face_cam;
   for (std::size_t i = 0; i < occluders.size(); ++i) {
     const OccluderOptions& occluder = occluders[i];
@@ -52,7 +52,7 @@ void FillOccluders(const std::vector<OccluderOptions>& occluders, const RoadMode
     for (const auto& face_map : OccluderFaces(road, occluder, s_cam, t_s)) {
       face_cam.clear();
       for (const Eigen::Vector3d& p_map : face_map) face_cam.push_back(T_cam_map * p_map);
-      FillPixelPolygon(projector.Project(face_cam), value, image);
+      FillPixelPolygon(projector.Project(face_cam), value, image, rule);
     }
   }
 }
@@ -82,6 +82,8 @@ void DriveSimulator::RenderMask(const FrameContext& context, bool noise, SimFram
     if (Overlaps(m.s_min, m.s_max, s0, s1)) window_markings.push_back(m.id - 1);
   }
   const int n_blobs = noise ? blobs : 0;
+  const FillRule mask_rule =
+      seg.mask_rasterizer == "pixel_centers" ? FillRule::kPixelCenters : FillRule::kOpenCvFillPoly;
   const int candidates =
       std::min<int>(kInstanceIdFactor - 1, lines.size() + window_markings.size() + n_blobs);
   // Random instance indices (a network's indices carry no identity across frames).
@@ -97,7 +99,7 @@ void DriveSimulator::RenderMask(const FrameContext& context, bool noise, SimFram
     if (jitter.active()) {
       for (Eigen::Vector2d& q : jittered) q = jitter.Apply(q);
     }
-    const cv::Rect box = FillPixelPolygon(jittered, p->instance.value, &frame->mask);
+    const cv::Rect box = FillPixelPolygon(jittered, p->instance.value, &frame->mask, mask_rule);
     if (box.empty()) return;
     p->roi = p->drawn ? (p->roi | box) : box;
     p->drawn = true;
@@ -135,7 +137,7 @@ void DriveSimulator::RenderMask(const FrameContext& context, bool noise, SimFram
   // instances when the segmentation labels them.
   FillOccluders(scenario_.occluders, world_.road(), context.T_cam_map, context.s_cam,
                 context.index / scenario_.camera.rate_hz, mask_projector_, 0, seg.occluder_class_id,
-                &frame->mask);
+                &frame->mask, mask_rule);
   for (int b = 0; b < n_blobs; ++b) {
     // A small star-shaped polygon of a random marking class below the image's middle.
     const int class_id = marking_class_ids_[random.UniformInt(0, marking_class_ids_.size() - 1)];

@@ -2,7 +2,9 @@
 
 #include <algorithm>
 #include <cmath>
+#include <limits>
 #include <opencv2/imgproc.hpp>
+#include <vector>
 
 namespace ipm_road_mapper {
 namespace sim {
@@ -20,6 +22,68 @@ bool RadialMonotonic(const CameraIntrinsics& in, double r_max) {
     }
   }
   return true;
+}
+
+cv::Rect FillWithOpenCv(const std::vector<Eigen::Vector2d>& uv, double value, cv::Mat* image) {
+  std::vector<cv::Point> points;
+  points.reserve(uv.size());
+  const double scale = 1 << kFillShift;
+  int u0 = INT32_MAX, v0 = INT32_MAX, u1 = INT32_MIN, v1 = INT32_MIN;
+  for (const Eigen::Vector2d& p : uv) {
+    points.emplace_back(static_cast<int>(std::lround(p.x() * scale)),
+                        static_cast<int>(std::lround(p.y() * scale)));
+    u0 = std::min(u0, static_cast<int>(std::floor(p.x())));
+    v0 = std::min(v0, static_cast<int>(std::floor(p.y())));
+    u1 = std::max(u1, static_cast<int>(std::ceil(p.x())));
+    v1 = std::max(v1, static_cast<int>(std::ceil(p.y())));
+  }
+  const cv::Rect box =
+      cv::Rect(u0, v0, u1 - u0 + 1, v1 - v0 + 1) & cv::Rect(0, 0, image->cols, image->rows);
+  if (box.empty()) return {};
+  const cv::Point* contour = points.data();
+  const int count = static_cast<int>(points.size());
+  cv::fillPoly(*image, &contour, &count, 1, cv::Scalar::all(value), cv::LINE_8, kFillShift);
+  return box;
+}
+
+cv::Rect FillPixelCenters(const std::vector<Eigen::Vector2d>& uv, double value, cv::Mat* image) {
+  double v_min = std::numeric_limits<double>::infinity(), v_max = -v_min;
+  for (const Eigen::Vector2d& p : uv) {
+    v_min = std::min(v_min, p.y());
+    v_max = std::max(v_max, p.y());
+  }
+  // Rows whose centers lie within the polygon's extent, clipped to the image.
+  const int row_begin = static_cast<int>(std::max(std::ceil(v_min), 0.0));
+  const int row_end = static_cast<int>(std::min(std::floor(v_max), image->rows - 1.0));
+  int u0 = INT32_MAX, v0 = INT32_MAX, u1 = INT32_MIN, v1 = INT32_MIN;
+  std::vector<double> crossings;
+  for (int v = row_begin; v <= row_end; ++v) {
+    // Where the edges cross the row's center line; half-open in v so that a vertex on the
+    // line counts once (even-odd rule).
+    crossings.clear();
+    for (std::size_t i = 0; i < uv.size(); ++i) {
+      const Eigen::Vector2d& a = uv[i];
+      const Eigen::Vector2d& b = uv[(i + 1) % uv.size()];
+      if ((a.y() <= v && v < b.y()) || (b.y() <= v && v < a.y())) {
+        crossings.push_back(a.x() + (v - a.y()) * (b.x() - a.x()) / (b.y() - a.y()));
+      }
+    }
+    std::sort(crossings.begin(), crossings.end());
+    for (std::size_t k = 0; k + 1 < crossings.size(); k += 2) {
+      // Pixels whose centers u satisfy x0 <= u < x1, clipped to the image.
+      const double first = std::max(std::ceil(crossings[k]), 0.0);
+      const double last = std::min(std::ceil(crossings[k + 1]) - 1.0, image->cols - 1.0);
+      if (first > last) continue;
+      const int a = static_cast<int>(first), b = static_cast<int>(last);
+      image->row(v).colRange(a, b + 1).setTo(cv::Scalar::all(value));
+      u0 = std::min(u0, a);
+      u1 = std::max(u1, b);
+      v0 = std::min(v0, v);
+      v1 = std::max(v1, v);
+    }
+  }
+  if (u0 > u1) return {};
+  return cv::Rect(u0, v0, u1 - u0 + 1, v1 - v0 + 1);
 }
 
 }  // namespace
@@ -99,27 +163,14 @@ std::vector<Eigen::Vector2d> FrustumProjector::Project(
   return uv;
 }
 
-cv::Rect FillPixelPolygon(const std::vector<Eigen::Vector2d>& uv, double value, cv::Mat* image) {
-  if (uv.size() < 3) return {};
-  std::vector<cv::Point> points;
-  points.reserve(uv.size());
-  const double scale = 1 << kFillShift;
-  int u0 = INT32_MAX, v0 = INT32_MAX, u1 = INT32_MIN, v1 = INT32_MIN;
+cv::Rect FillPixelPolygon(const std::vector<Eigen::Vector2d>& uv, double value, cv::Mat* image,
+                          FillRule rule) {
+  if (uv.size() < 3 || image->empty()) return {};
   for (const Eigen::Vector2d& p : uv) {
-    points.emplace_back(static_cast<int>(std::lround(p.x() * scale)),
-                        static_cast<int>(std::lround(p.y() * scale)));
-    u0 = std::min(u0, static_cast<int>(std::floor(p.x())));
-    v0 = std::min(v0, static_cast<int>(std::floor(p.y())));
-    u1 = std::max(u1, static_cast<int>(std::ceil(p.x())));
-    v1 = std::max(v1, static_cast<int>(std::ceil(p.y())));
+    if (!p.allFinite()) return {};
   }
-  const cv::Rect box =
-      cv::Rect(u0, v0, u1 - u0 + 1, v1 - v0 + 1) & cv::Rect(0, 0, image->cols, image->rows);
-  if (box.empty()) return {};
-  const cv::Point* contour = points.data();
-  const int count = static_cast<int>(points.size());
-  cv::fillPoly(*image, &contour, &count, 1, cv::Scalar::all(value), cv::LINE_8, kFillShift);
-  return box;
+  return rule == FillRule::kPixelCenters ? FillPixelCenters(uv, value, image)
+                                         : FillWithOpenCv(uv, value, image);
 }
 
 JitterField::JitterField(double amplitude_px, double wavelength_px,

@@ -152,6 +152,32 @@ TEST(SimOccluder, LabelledVehicleIsItsOwnInstanceWhereTheBackgroundVehicleIsZero
             std::string::npos);
 }
 
+// segmentation.mask_rasterizer: pixel_centers labels what cv::fillPoly labels less the pixels
+// whose centers are outside (about half a pixel around every instance).
+TEST(SimMask, PixelCenterRasterizerLabelsASubsetOfTheDefaultOne) {
+  ScenarioOptions scenario = Scenario("public_road");
+  RenderSettings exact;
+  exact.segmentation_noise = false;
+  exact.image = false;
+  DriveSimulator fill_poly(scenario, Classes(), 1, 30);
+  scenario.segmentation.mask_rasterizer = "pixel_centers";
+  DriveSimulator centers(scenario, Classes(), 1, 30);
+  const SimFrame a = fill_poly.RenderFrame(20, exact), b = centers.RenderFrame(20, exact);
+  const int labelled_a = cv::countNonZero(a.mask), labelled_b = cv::countNonZero(b.mask);
+  EXPECT_GT(labelled_b, 10000);
+  // Every pixel the center rule labels is labelled under cv::fillPoly (but a few whose
+  // centers lie within cv::fillPoly's 1/16 px rounding of an edge), with the same instance
+  // but where two instances touch (the later one's wider rim covers the earlier one there).
+  EXPECT_LT(cv::countNonZero((b.mask != 0) & (a.mask == 0)), labelled_b / 1000);
+  EXPECT_LT(cv::countNonZero((b.mask != 0) & (a.mask != b.mask)), labelled_b / 1000);
+  // The difference is a rim: a few percent of the paint, not nothing.
+  EXPECT_GT(labelled_a - labelled_b, labelled_b / 50);
+  EXPECT_LT(labelled_a - labelled_b, labelled_b / 2);
+  EXPECT_NE(ErrorOf(kRoad + "segmentation: {mask_rasterizer: exact}")
+                .find("segmentation.mask_rasterizer"),
+            std::string::npos);
+}
+
 TEST(SimSplit, SplitPartsAreInstancesOfTheSameElementCountedOnceAsVisible) {
   ScenarioOptions scenario = Scenario("public_road");
   scenario.segmentation.split_instance_prob = 1.0;

@@ -2,7 +2,10 @@
 // camera or far outside the field of view) against a per-pixel ray-casting reference.
 #include <gtest/gtest.h>
 
+#include <cmath>
+#include <cstdint>
 #include <opencv2/core.hpp>
+#include <vector>
 
 #include "ipm_road_mapper/sim/renderer.h"
 #include "ipm_road_mapper/sim/scenario.h"
@@ -72,6 +75,68 @@ TEST(SimRenderer, ClipPolygonKeepsTheFrontPartExactly) {
   // Entirely behind: nothing; entirely in front: unchanged.
   EXPECT_TRUE(ClipPolygon(square, Eigen::Vector4d(0, 0, 1, -2.0)).empty());
   EXPECT_EQ(ClipPolygon(square, Eigen::Vector4d(0, 0, 1, 5.0)).size(), 4u);
+}
+
+TEST(SimRenderer, PixelCenterFillLabelsExactlyThePixelsWhoseCenterIsInside) {
+  // An axis-aligned rectangle off the pixel grid: columns 11-30 and rows 21-40 have their
+  // centers inside. cv::fillPoly (the default rule) labels columns 10-31 and rows 20-41: half
+  // a pixel more on each side.
+  const std::vector<Eigen::Vector2d> rectangle = {
+      {10.3, 20.3}, {30.7, 20.3}, {30.7, 40.7}, {10.3, 40.7}};
+  cv::Mat dilated = cv::Mat::zeros(64, 64, CV_16UC1);
+  FillPixelPolygon(rectangle, 7, &dilated);
+  EXPECT_EQ(cv::countNonZero(dilated), 22 * 22);
+  cv::Mat image = cv::Mat::zeros(64, 64, CV_16UC1);
+  const cv::Rect box = FillPixelPolygon(rectangle, 7, &image, FillRule::kPixelCenters);
+  EXPECT_EQ(box, cv::Rect(11, 21, 20, 20));
+  EXPECT_EQ(cv::countNonZero(image), 400);
+  EXPECT_EQ(image.at<std::uint16_t>(21, 11), 7);
+  EXPECT_EQ(image.at<std::uint16_t>(20, 11), 0);
+  EXPECT_EQ(image.at<std::uint16_t>(21, 10), 0);
+  EXPECT_EQ(image.at<std::uint16_t>(41, 30), 0);
+
+  // A slanted triangle and a concave arrow-like polygon: every pixel against the point test.
+  const std::vector<std::vector<Eigen::Vector2d>> polygons = {
+      {{5.2, 5.3}, {50.6, 12.4}, {20.1, 55.8}},
+      {{4.5, 30.2},
+       {30.4, 4.1},
+       {58.7, 30.6},
+       {40.2, 30.5},
+       {40.6, 59.3},
+       {20.3, 59.7},
+       {20.8, 30.1}}};
+  for (const std::vector<Eigen::Vector2d>& polygon : polygons) {
+    cv::Mat filled = cv::Mat::zeros(64, 64, CV_8UC1);
+    FillPixelPolygon(polygon, 1, &filled, FillRule::kPixelCenters);
+    int mismatches = 0, inside_count = 0;
+    for (int v = 0; v < 64; ++v) {
+      for (int u = 0; u < 64; ++u) {
+        bool inside = false;  // even-odd ray test
+        for (std::size_t i = 0, j = polygon.size() - 1; i < polygon.size(); j = i++) {
+          const Eigen::Vector2d& a = polygon[i];
+          const Eigen::Vector2d& b = polygon[j];
+          if ((a.y() > v) != (b.y() > v) &&
+              u < a.x() + (v - a.y()) * (b.x() - a.x()) / (b.y() - a.y())) {
+            inside = !inside;
+          }
+        }
+        inside_count += inside;
+        mismatches += inside != (filled.at<std::uint8_t>(v, u) != 0);
+      }
+    }
+    EXPECT_GT(inside_count, 500);
+    EXPECT_EQ(mismatches, 0);
+  }
+  // Outside the image or not finite: nothing, and an empty box.
+  cv::Mat untouched = cv::Mat::zeros(64, 64, CV_8UC1);
+  for (const FillRule rule : {FillRule::kPixelCenters, FillRule::kOpenCvFillPoly}) {
+    EXPECT_TRUE(
+        FillPixelPolygon({{70.0, 1.0}, {90.0, 1.0}, {80.0, 20.0}}, 1, &untouched, rule).empty());
+    EXPECT_TRUE(
+        FillPixelPolygon({{1.0, 1.0}, {std::nan(""), 1.0}, {8.0, 20.0}}, 1, &untouched, rule)
+            .empty());
+  }
+  EXPECT_EQ(cv::countNonZero(untouched), 0);
 }
 
 TEST(SimRenderer, PolygonStraddlingTheCameraPlaneRendersLikeRayCasting) {

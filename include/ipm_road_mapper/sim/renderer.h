@@ -48,9 +48,22 @@ class FrustumProjector {
   std::array<Eigen::Vector4d, 6> planes_;
 };
 
-// Fills a pixel polygon (pixel centers at integer coordinates) with `value`, at 1/16 px
-// precision. Returns the filled bounding box clipped to the image (empty when outside).
-cv::Rect FillPixelPolygon(const std::vector<Eigen::Vector2d>& uv, double value, cv::Mat* image);
+// How a polygon becomes pixels (segmentation.mask_rasterizer).
+enum class FillRule {
+  // cv::fillPoly at 1/16 px: it also labels the pixels an edge only touches, up to half a
+  // pixel outside the polygon, so every shape comes out half a pixel too large on each side
+  // (docs/synthetic_drives.md, "Rendering"). The benchmark drives' masks, for continuity.
+  kOpenCvFillPoly,
+  // Every pixel whose center lies inside the polygon (even-odd rule): the 50 %-coverage rule
+  // of a segmentation network, which the mapper's sub-pixel outline assumes.
+  kPixelCenters,
+};
+
+// Fills a pixel polygon (pixel centers at integer coordinates) with `value` by `rule`.
+// Returns the filled bounding box clipped to the image (empty when outside, or when a
+// vertex is not finite).
+cv::Rect FillPixelPolygon(const std::vector<Eigen::Vector2d>& uv, double value, cv::Mat* image,
+                          FillRule rule = FillRule::kOpenCvFillPoly);
 
 // A smooth random displacement field over the image (segmentation boundary jitter): two
 // sinusoidal waves per axis with random directions and phases, amplitude `amplitude_px`

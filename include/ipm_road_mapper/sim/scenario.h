@@ -162,6 +162,10 @@ struct SegmentationNoiseOptions {
   // background, as a network that segments road paint only would; 1..65 draws each as an
   // instance of that class (class_id * 1000 + occluder index + 1), as a panoptic one would.
   int occluder_class_id = 0;
+  // How the mask's polygons become pixels (renderer.h FillRule): "opencv_fill_poly" (half a
+  // pixel too large on each side; the default, which the benchmark's figures were measured
+  // on) or "pixel_centers" (the 50 %-coverage rule the mapper's outline assumes).
+  std::string mask_rasterizer = "opencv_fill_poly";
 };
 
 // A vehicle driving ahead of the ego vehicle; its box hides the road behind it (drawn as
