@@ -79,10 +79,6 @@ int NearestFrame(const GroundTruth& gt, const std::vector<int>& order, double st
   return best;
 }
 
-}  // namespace
-
-namespace {
-
 // The calibration's error over its reported covariance (ExtrinsicMetrics::err_sigmas,
 // nees_observed).
 void EvaluateCalibrationConsistency(const VectorMap& map, const Eigen::Isometry3d& T_true,

@@ -82,8 +82,6 @@ void DriveSimulator::RenderMask(const FrameContext& context, bool noise, SimFram
     if (Overlaps(m.s_min, m.s_max, s0, s1)) window_markings.push_back(m.id - 1);
   }
   const int n_blobs = noise ? blobs : 0;
-  const FillRule mask_rule =
-      seg.mask_rasterizer == "pixel_centers" ? FillRule::kPixelCenters : FillRule::kOpenCvFillPoly;
   const int candidates =
       std::min<int>(kInstanceIdFactor - 1, lines.size() + window_markings.size() + n_blobs);
   // Random instance indices (a network's indices carry no identity across frames).
@@ -99,7 +97,8 @@ void DriveSimulator::RenderMask(const FrameContext& context, bool noise, SimFram
     if (jitter.active()) {
       for (Eigen::Vector2d& q : jittered) q = jitter.Apply(q);
     }
-    const cv::Rect box = FillPixelPolygon(jittered, p->instance.value, &frame->mask, mask_rule);
+    const cv::Rect box =
+        FillPixelPolygon(jittered, p->instance.value, &frame->mask, seg.mask_rasterizer);
     if (box.empty()) return;
     p->roi = p->drawn ? (p->roi | box) : box;
     p->drawn = true;
@@ -137,7 +136,7 @@ void DriveSimulator::RenderMask(const FrameContext& context, bool noise, SimFram
   // instances when the segmentation labels them.
   FillOccluders(scenario_.occluders, world_.road(), context.T_cam_map, context.s_cam,
                 context.index / scenario_.camera.rate_hz, mask_projector_, 0, seg.occluder_class_id,
-                &frame->mask, mask_rule);
+                &frame->mask, seg.mask_rasterizer);
   for (int b = 0; b < n_blobs; ++b) {
     // A small star-shaped polygon of a random marking class below the image's middle.
     const int class_id = marking_class_ids_[random.UniformInt(0, marking_class_ids_.size() - 1)];

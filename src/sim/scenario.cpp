@@ -238,11 +238,15 @@ void ParseSegmentation(OptionsReader r, SegmentationNoiseOptions* o) {
                ? ""
                : "must be 0 (background) or a class id in 1.." + std::to_string(kMaxClassId);
   });
-  r.Read<std::string>("mask_rasterizer", &o->mask_rasterizer, [](const std::string& v) {
+  std::string rasterizer =
+      o->mask_rasterizer == FillRule::kPixelCenters ? "pixel_centers" : "opencv_fill_poly";
+  r.Read<std::string>("mask_rasterizer", &rasterizer, [](const std::string& v) {
     return v == "opencv_fill_poly" || v == "pixel_centers"
                ? std::string()
                : std::string("must be opencv_fill_poly or pixel_centers");
   });
+  o->mask_rasterizer =
+      rasterizer == "pixel_centers" ? FillRule::kPixelCenters : FillRule::kOpenCvFillPoly;
   r.RejectUnknownKeys();
 }
 

@@ -160,7 +160,7 @@ TEST(SimMask, PixelCenterRasterizerLabelsASubsetOfTheDefaultOne) {
   exact.segmentation_noise = false;
   exact.image = false;
   DriveSimulator fill_poly(scenario, Classes(), 1, 30);
-  scenario.segmentation.mask_rasterizer = "pixel_centers";
+  scenario.segmentation.mask_rasterizer = FillRule::kPixelCenters;
   DriveSimulator centers(scenario, Classes(), 1, 30);
   const SimFrame a = fill_poly.RenderFrame(20, exact), b = centers.RenderFrame(20, exact);
   const int labelled_a = cv::countNonZero(a.mask), labelled_b = cv::countNonZero(b.mask);
@@ -173,6 +173,10 @@ TEST(SimMask, PixelCenterRasterizerLabelsASubsetOfTheDefaultOne) {
   // The difference is a rim: a few percent of the paint, not nothing.
   EXPECT_GT(labelled_a - labelled_b, labelled_b / 50);
   EXPECT_LT(labelled_a - labelled_b, labelled_b / 2);
+  EXPECT_EQ(Load(kRoad).segmentation.mask_rasterizer, FillRule::kOpenCvFillPoly);
+  EXPECT_EQ(
+      Load(kRoad + "segmentation: {mask_rasterizer: pixel_centers}").segmentation.mask_rasterizer,
+      FillRule::kPixelCenters);
   EXPECT_NE(ErrorOf(kRoad + "segmentation: {mask_rasterizer: exact}")
                 .find("segmentation.mask_rasterizer"),
             std::string::npos);

@@ -10,6 +10,7 @@
 #include <vector>
 
 #include "ipm_road_mapper/core/geometry/pinhole_camera.h"
+#include "ipm_road_mapper/sim/fill_rule.h"
 
 namespace ipm_road_mapper {
 namespace sim {
@@ -46,17 +47,6 @@ class FrustumProjector {
   PinholeCamera camera_;
   double near_m_, far_m_;
   std::array<Eigen::Vector4d, 6> planes_;
-};
-
-// How a polygon becomes pixels (segmentation.mask_rasterizer).
-enum class FillRule {
-  // cv::fillPoly at 1/16 px: it also labels the pixels an edge only touches, up to half a
-  // pixel outside the polygon, so every shape comes out half a pixel too large on each side
-  // (docs/synthetic_drives.md, "Rendering"). The benchmark drives' masks, for continuity.
-  kOpenCvFillPoly,
-  // Every pixel whose center lies inside the polygon (even-odd rule): the 50 %-coverage rule
-  // of a segmentation network, which the mapper's sub-pixel outline assumes.
-  kPixelCenters,
 };
 
 // Fills a pixel polygon (pixel centers at integer coordinates) with `value` by `rule`.

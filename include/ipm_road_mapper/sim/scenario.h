@@ -11,6 +11,7 @@
 #include "ipm_road_mapper/core/frontend/class_table.h"
 #include "ipm_road_mapper/core/geometry/pinhole_camera.h"
 #include "ipm_road_mapper/core/io/yaml_options.h"
+#include "ipm_road_mapper/sim/fill_rule.h"
 
 namespace ipm_road_mapper {
 namespace sim {
@@ -162,10 +163,9 @@ struct SegmentationNoiseOptions {
   // background, as a network that segments road paint only would; 1..65 draws each as an
   // instance of that class (class_id * 1000 + occluder index + 1), as a panoptic one would.
   int occluder_class_id = 0;
-  // How the mask's polygons become pixels (renderer.h FillRule): "opencv_fill_poly" (half a
-  // pixel too large on each side; the default, which the benchmark's figures were measured
-  // on) or "pixel_centers" (the 50 %-coverage rule the mapper's outline assumes).
-  std::string mask_rasterizer = "opencv_fill_poly";
+  // How the mask's polygons become pixels (fill_rule.h; YAML "opencv_fill_poly", the default,
+  // which the benchmark's figures were measured on, or "pixel_centers").
+  FillRule mask_rasterizer = FillRule::kOpenCvFillPoly;
 };
 
 // A vehicle driving ahead of the ego vehicle; its box hides the road behind it (drawn as
