@@ -223,9 +223,14 @@ void DriveSimulator::RenderImage(const FrameContext& context, SimFrame* frame) c
   for (int q = q1; q >= q0; --q) {
     const double sa = q * kRoadQuadM, sb = sa + kRoadQuadM;
     const int shade = static_cast<int>(SplitMix64(static_cast<std::uint64_t>(q + 100000)) % 9) - 4;
+    // The asphalt in two quads either side of a crown's ridge (flat quads would cut it).
+    const double ridge = road.crown() > 0.0
+                             ? std::clamp(road.options().surface.crown_offset_m, l_right, l_left)
+                             : l_right;
     for (const auto& [la, lb, gray] :
          {std::tuple<double, double, int>{l_right - shoulder, l_right, kShoulderGray},
-          {l_right, l_left, kAsphaltGray + shade},
+          {l_right, ridge, kAsphaltGray + shade},
+          {ridge, l_left, kAsphaltGray + shade},
           {l_left, l_left + shoulder, kShoulderGray}}) {
       if (lb <= la) continue;
       quad[0] = context.T_cam_map * road.SurfacePoint(sa, la);

@@ -19,6 +19,7 @@ RoadModel::RoadModel(const RoadOptions& options) : options_(options) {
   }
   length_ = piece.s0;
   cross_slope_ = options_.surface.cross_slope_pct / 100.0;
+  crown_ = options_.surface.crown_pct / 100.0;
   for (const auto& knot : options_.surface.grade) {
     const double grade = knot.grade_pct / 100.0;
     double z = 0.0;
@@ -123,10 +124,11 @@ double RoadModel::LaneCenterOffset(int lane_index) const {
 
 SightProfile::SightProfile(const RoadModel& road, const Eigen::Vector3d& p_map_cam, double s_hint,
                            double range_m, double step_m)
-    : step_(step_m), cross_slope_(road.cross_slope()) {
+    : road_(&road), step_(step_m) {
   const Eigen::Vector2d sl = road.Locate(p_map_cam.head<2>(), s_hint);
   s_cam_ = sl.x();
-  zp_cam_ = p_map_cam.z() - cross_slope_ * sl.y();
+  l_cam_ = sl.y();
+  z_cam_ = p_map_cam.z();
   const int n = static_cast<int>(std::ceil(range_m / step_)) + 2;
   profile_.resize(n);
   for (int i = 0; i < n; ++i) profile_[i] = road.ProfileHeight(s_cam_ + i * step_);
@@ -135,12 +137,12 @@ SightProfile::SightProfile(const RoadModel& road, const Eigen::Vector3d& p_map_c
 bool SightProfile::Visible(double s, double l, double z) const {
   const double span = s - s_cam_;
   if (span <= 0.5) return true;
-  const double zp = z - cross_slope_ * l;
   const int last =
       std::min(static_cast<int>((span - 0.3) / step_), static_cast<int>(profile_.size()) - 1);
   for (int i = 1; i <= last; ++i) {
-    const double chord = zp_cam_ + (i * step_ / span) * (zp - zp_cam_);
-    if (chord < profile_[i] - 1e-4) return false;
+    const double f = i * step_ / span;
+    const double chord = z_cam_ + f * (z - z_cam_);
+    if (chord < profile_[i] + road_->CrossHeight(l_cam_ + f * (l - l_cam_)) - 1e-4) return false;
   }
   return true;
 }

@@ -49,6 +49,10 @@ void ParseSurface(OptionsReader r, SurfaceOptions* o) {
     o->grade.push_back(k);
   });
   r.Read<double>("cross_slope_pct", &o->cross_slope_pct, CheckFinite);
+  r.Read<double>("crown_pct", &o->crown_pct, [](const double& c) -> std::string {
+    return c >= 0.0 && c <= 10.0 ? "" : "must be within 0-10 %";
+  });
+  r.Read<double>("crown_offset_m", &o->crown_offset_m, CheckFinite);
   ForEachEntry(&r, "waves", [&](OptionsReader* e) {
     SurfaceWave w;
     e->ReadRequired<double>("amplitude_m", &w.amplitude_m, CheckNonNegative);

@@ -2,10 +2,12 @@
 // odometry model, stamps, and the road model's geometry.
 #include <gtest/gtest.h>
 
+#include <cmath>
 #include <cstdio>
 #include <fstream>
 #include <sstream>
 
+#include "ipm_road_mapper/core/geometry/rigid_transform.h"
 #include "ipm_road_mapper/sim/drive_simulator.h"
 #include "ipm_road_mapper/sim/ipm_check.h"
 #include "ipm_road_mapper/sim/sim_random.h"
@@ -193,6 +195,73 @@ TEST(SimRoad, VehicleRestsOnTheSurfaceAndFollowsTheRoad) {
     const Eigen::Vector2d forward = T.linear().col(0).head<2>().normalized();
     EXPECT_GT(forward.dot(road.Centerline(sl.x()).Tangent()), std::cos(2.0 * M_PI / 180.0));
   }
+}
+
+// A crown makes the road a roof across: each side a plane falling from the ridge, the
+// cross slope on top. What the mapper faces on a real carriageway (docs/synthetic_drives.md,
+// "The crown"), which the planar cross slope never showed it.
+TEST(SimRoad, CrownIsARoofAcrossTheRoadWithItsRidgeWhereConfigured) {
+  RoadOptions options = Scenario("public_road").road;
+  options.surface.cross_slope_pct = 1.0;
+  options.surface.crown_pct = 2.0;
+  options.surface.crown_offset_m = 1.75;
+  const RoadModel road(options);
+  const double s = 40.0;
+  // Right of the ridge: rising toward it at cross + crown; left of it: cross - crown.
+  EXPECT_NEAR(road.Height(s, 1.0) - road.Height(s, 0.0), 0.03, 1e-12);
+  EXPECT_NEAR(road.Height(s, 3.0) - road.Height(s, 2.0), -0.01, 1e-12);
+  // The ridge is the highest point of a cross-section without cross slope.
+  options.surface.cross_slope_pct = 0.0;
+  const RoadModel roof(options);
+  for (double l : {-5.25, -1.75, 0.0, 1.7, 1.8, 5.25}) {
+    EXPECT_LT(roof.Height(s, l), roof.Height(s, 1.75)) << l;
+  }
+  EXPECT_NEAR(roof.Height(s, 5.25) - roof.Height(s, 1.75), -0.07, 1e-12);
+  EXPECT_EQ(roof.CrossHeight(1.75), 0.0);
+  // Without a crown the cross-section is the plane it always was.
+  options.surface.crown_pct = 0.0;
+  options.surface.cross_slope_pct = 2.0;
+  const RoadModel plane(options);
+  EXPECT_NEAR(plane.Height(s, 3.0) - plane.Height(s, -3.0), 0.12, 1e-12);
+}
+
+TEST(SimRoad, VehicleOnOneSideOfTheRidgeRollsWithThatSide) {
+  ScenarioOptions scenario = Scenario("public_road");
+  scenario.road.surface.cross_slope_pct = 0.0;
+  scenario.road.surface.crown_pct = 2.0;
+  scenario.road.surface.crown_offset_m = 1.75;  // the left line of the vehicle's lane 1
+  scenario.vehicle.roll_amplitude_deg = 0.0;
+  scenario.vehicle.wander_amplitude_m = 0.0;
+  const RoadModel road(scenario.road);
+  const VehicleTrajectory trajectory(road, scenario.vehicle, 1);
+  for (double t : {0.5, 1.7, 2.9}) {
+    const Eigen::Isometry3d T = trajectory.Pose(t);
+    const double roll = RpyFromRotation(T.linear()).x();
+    EXPECT_NEAR(roll, std::atan(0.02), 1e-3) << t;  // left side up, toward the ridge
+  }
+}
+
+TEST(SimRoad, RidgeHidesTheRoadBeyondItFromALowCamera) {
+  RoadOptions options = Scenario("public_road").road;
+  options.surface = SurfaceOptions();
+  options.surface.crown_pct = 10.0;  // a steep roof: 0.5 m over 5 m
+  options.surface.crown_offset_m = 0.0;
+  const RoadModel road(options);
+  const double s_cam = 20.0, l_cam = -5.0;
+  const Eigen::Vector3d camera = road.SurfacePoint(s_cam, l_cam) + Eigen::Vector3d(0, 0, 0.2);
+  const SightProfile sight(road, camera, s_cam, 40.0);
+  // Across the ridge, on the far side's surface: hidden; the near side: in sight; the same
+  // point lifted above the ridge's sight line: in sight.
+  EXPECT_FALSE(sight.Visible(s_cam + 6.0, 5.0, road.Height(s_cam + 6.0, 5.0)));
+  EXPECT_TRUE(sight.Visible(s_cam + 6.0, -4.0, road.Height(s_cam + 6.0, -4.0)));
+  EXPECT_TRUE(sight.Visible(s_cam + 6.0, 5.0, road.Height(s_cam + 6.0, 5.0) + 1.5));
+  // A planar road with the same cross slope on both sides hides nothing.
+  options.surface.crown_pct = 0.0;
+  options.surface.cross_slope_pct = 10.0;
+  const RoadModel plane(options);
+  const Eigen::Vector3d camera2 = plane.SurfacePoint(s_cam, l_cam) + Eigen::Vector3d(0, 0, 0.2);
+  const SightProfile sight2(plane, camera2, s_cam, 40.0);
+  EXPECT_TRUE(sight2.Visible(s_cam + 6.0, 5.0, plane.Height(s_cam + 6.0, 5.0)));
 }
 
 }  // namespace

@@ -114,6 +114,14 @@ TEST(SimScenario, BadValuesNameTheirKey) {
             std::string::npos);
   EXPECT_NE(ErrorOf("road:\n  segments: [{type: straight, length_m: 100}]\n").find("name"),
             std::string::npos);
+  const std::string road = "name: t\nroad:\n  segments: [{type: straight, length_m: 100}]\n";
+  EXPECT_NE(ErrorOf(road + "  surface: {crown_pct: -1}\n").find("road.surface.crown_pct"),
+            std::string::npos);
+  EXPECT_NE(ErrorOf(road + "  surface: {crown_pct: 12}\n").find("road.surface.crown_pct"),
+            std::string::npos);
+  EXPECT_EQ(
+      Load(road + "  surface: {crown_pct: 2, crown_offset_m: 1.75}\n").road.surface.crown_offset_m,
+      1.75);
 }
 
 TEST(SimScenario, UnknownOrWrongKindClassNamesAreErrors) {

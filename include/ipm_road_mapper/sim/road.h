@@ -34,14 +34,20 @@ class RoadModel {
   // Centerline position, heading and curvature at s.
   CenterlinePoint Centerline(double s) const;
 
-  // Surface height at (s, l): z_grade(s) + cross_slope * l + waves(s) + bumps(s).
-  double Height(double s, double l) const { return ProfileHeight(s) + cross_slope_ * l; }
+  // Surface height at (s, l): z_grade(s) + CrossHeight(l) + waves(s) + bumps(s).
+  double Height(double s, double l) const { return ProfileHeight(s) + CrossHeight(l); }
+
+  // The part of the height that depends on l only: cross_slope * l - crown * |l - l_crown|.
+  double CrossHeight(double l) const {
+    return cross_slope_ * l - crown_ * std::abs(l - options_.surface.crown_offset_m);
+  }
 
   // The part of the height that depends on s only (grade, waves, bumps).
   double ProfileHeight(double s) const;
 
-  // Cross slope dz/dl (m/m).
+  // Cross slope dz/dl (m/m) without the crown; the crown's fall (m/m, >= 0).
   double cross_slope() const { return cross_slope_; }
+  double crown() const { return crown_; }
 
   // The 3D surface point at (s, l) in the map frame.
   Eigen::Vector3d SurfacePoint(double s, double l) const;
@@ -76,14 +82,16 @@ class RoadModel {
   std::vector<Piece> pieces_;
   double length_ = 0.0;
   double cross_slope_ = 0.0;
+  double crown_ = 0.0;
   std::vector<double> knot_s_, knot_grade_, knot_z_;  // grade as a fraction
 };
 
 // Visibility of surface points from a camera over the road's own relief. The line of sight
-// from the camera to a point is tested against the surface profile along s, with the cross
-// slope removed: z' = z - cross_slope * l is linear along any straight line of sight on a
-// straight road, so the test is exact there; on arcs the lateral path of the sight line is
-// approximated linearly in s (a few cm for radii >= 100 m within 40 m).
+// from the camera to a point is tested against the surface along s: its lateral offset l is
+// linear in s on a straight road, so at each profile sample the sight line's height is
+// compared with ProfileHeight(s) + CrossHeight(l) there, which is exact on straight roads
+// (a ridge the sight line crosses can hide what lies beyond it); on arcs the lateral path
+// of the sight line is approximated linearly in s (a few cm for radii >= 100 m within 40 m).
 class SightProfile {
  public:
   SightProfile() = default;  // sees everything
@@ -95,7 +103,8 @@ class SightProfile {
   bool Visible(double s, double l, double z) const;
 
  private:
-  double s_cam_ = 0.0, zp_cam_ = 0.0, step_ = 0.25, cross_slope_ = 0.0;
+  const RoadModel* road_ = nullptr;
+  double s_cam_ = 0.0, l_cam_ = 0.0, z_cam_ = 0.0, step_ = 0.25;
   std::vector<double> profile_;  // ProfileHeight at s_cam_ + i * step_
 };
 

@@ -47,10 +47,16 @@ struct SurfaceBump {
   double length_m = 2.0;
 };
 
-// Road surface height z(s, l) = grade integral + cross slope * l + waves + bumps.
+// Road surface height z(s, l) = grade integral + cross slope * l - crown * |l - l_crown|
+// + waves + bumps. The crown makes the road a roof across: two planes meeting at a ridge
+// line (a real carriageway falls to both gutters from its centre line, 1.5-2.5 % each way),
+// so a vehicle on one side rests on that side's plane and the lines beyond the ridge lie
+// below it.
 struct SurfaceOptions {
   std::vector<GradeKnot> grade;  // empty: flat profile
   double cross_slope_pct = 0.0;  // > 0: the left side (l > 0) is higher
+  double crown_pct = 0.0;        // > 0: the surface falls this steeply away from the ridge
+  double crown_offset_m = 0.0;   // the ridge's lateral offset l_crown (0: the centerline)
   std::vector<SurfaceWave> waves;
   std::vector<SurfaceBump> bumps;
 };
