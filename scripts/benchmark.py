@@ -42,6 +42,10 @@ BLOBS = "public_road_blobs_1.0"  # public_road, segmentation.spurious_blobs_per_
 # the mapper's table does not know, which the front end takes for an occluder): what the
 # unseen occluders of urban cost.
 URBAN_LABELLED = "urban_occluders_labelled"
+# public_road with its planar 2 % cross slope replaced by a 2 % crown whose ridge is the left
+# line of the vehicle's lane: the lines beyond it lie 7 cm below the body's plane at 5.25 m,
+# as the lines across av2_pit_dev's centre line do (docs/synthetic_drives.md).
+CROWN = "public_road_crown"
 
 
 def run(cmd, log):
@@ -196,6 +200,13 @@ def blob_drive(args, out_root):
                             "segmentation: {spurious_blobs_per_frame: 1.0}")
 
 
+def crown_drive(args, out_root):
+    """public_road on a crowned carriageway (a roof across, ridge at the vehicle's left line)."""
+    return scenario_variant(args, out_root, CROWN, "public_road",
+                            "road: {surface: {cross_slope_pct: 0.0, crown_pct: 2.0, "
+                            "crown_offset_m: 1.75}}")
+
+
 def urban_labelled_drive(args, out_root):
     """urban with its vehicles ahead drawn as instances of class 30 instead of background."""
     return scenario_variant(args, out_root, URBAN_LABELLED, "urban",
@@ -260,6 +271,8 @@ def main():
             generations.submit(name, generate, args, path, drives[name])
         drives[BLOBS], path = blob_drive(args, out_root)
         generations.submit(BLOBS, generate, args, path, drives[BLOBS])
+        drives[CROWN], path = crown_drive(args, out_root)
+        generations.submit(CROWN, generate, args, path, drives[CROWN])
         if "urban" in scenarios:
             drives[URBAN_LABELLED], path = urban_labelled_drive(args, out_root)
             generations.submit(URBAN_LABELLED, generate, args, path, drives[URBAN_LABELLED])
@@ -285,7 +298,7 @@ def main():
             jobs.submit((name, "ours_ppsr"), map_and_evaluate, args, drives[name],
                         noise_config(args, drives[name], level),
                         os.path.join(out_root, "maps", name, "ours_ppsr"))
-        others = [n for n in drives if "_seed" in n] + [BLOBS]
+        others = [n for n in drives if "_seed" in n] + [BLOBS, CROWN]
         others += [URBAN_LABELLED] if URBAN_LABELLED in drives else []
         for name in others:
             for config in ("ipm", "ours_ppsr"):
