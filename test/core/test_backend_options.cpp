@@ -114,6 +114,22 @@ TEST(BackendOptions, ExtrinsicCalibrationOptionsAreReadAndValidated) {
   EXPECT_NE(ToString(o).find("backend.extrinsic_holdout_every_n_frames: 5\n"), std::string::npos);
 }
 
+TEST(BackendOptions, RoadCrownOptionsAreReadAndValidatedAndOffByDefault) {
+  EXPECT_EQ(BackendOptions().road_crown_slope_sigma, 0.0);  // the planar prior of every drive
+  const BackendOptions o = LoadFrom("{road_crown_slope_sigma: 0.03, road_crown_lateral_m: 2.5}");
+  EXPECT_EQ(o.road_crown_slope_sigma, 0.03);
+  EXPECT_EQ(o.road_crown_lateral_m, 2.5);
+  EXPECT_EQ(ErrorOf([] {
+              LoadFrom("{road_crown_slope_sigma: -0.01}");
+            }).rfind("backend.road_crown_slope_sigma: ", 0),
+            0u);
+  EXPECT_EQ(ErrorOf([] {
+              LoadFrom("{road_crown_lateral_m: 0}");
+            }).rfind("backend.road_crown_lateral_m: ", 0),
+            0u);
+  EXPECT_NE(ToString(o).find("backend.road_crown_slope_sigma: 0.03\n"), std::string::npos);
+}
+
 TEST(BackendOptions, DumpListsTheKernelAndTheGates) {
   BackendOptions o;
   o.robust_kernel = RobustKernel::kCauchy;

@@ -58,6 +58,16 @@ TEST(RoadSurfaceNear, ExtrapolatesTheClosestFrameAheadAndHandlesNoPoses) {
   EXPECT_EQ(RoadSurfaceNear({}, Eigen::Vector3d::Zero(), 6.0).frames, 0);
 }
 
+TEST(RoadSurfaceNear, GivesThePointsOffsetAcrossTheClosestFrame) {
+  auto poses = PitchingDrive();
+  for (Eigen::Isometry3d& T : poses) {  // heading +90 deg: base_link y is map -x
+    T.linear() = RotationFromRpy(0.0, 0.0, M_PI / 2.0);
+    T.translation() = Eigen::Vector3d(0.0, T.translation().x(), 0.0);
+  }
+  EXPECT_NEAR(RoadSurfaceNear(poses, Eigen::Vector3d(-5.25, 20.1, 0.0), 6.0).lateral_m, 5.25, 1e-9);
+  EXPECT_NEAR(RoadSurfaceNear(poses, Eigen::Vector3d(1.75, 20.0, 0.0), 6.0).lateral_m, -1.75, 1e-9);
+}
+
 TEST(PoseUncertaintyWhitening, IsThePixelSigmaForExactPosesAndWeakerOtherwise) {
   const PinholeCamera camera(test::Intrinsics1280x720(639.5, 359.5));
   const Eigen::Isometry3d T_base_cam = test::MountedCamera(0.0, 4.0 * kDeg, 0.0);

@@ -122,6 +122,8 @@ BackendOptions LoadBackendOptions(OptionsReader reader) {
                    [](const int& v) { return v >= 2 ? "" : "must be >= 2"; });
   reader.Read<double>("road_height_sigma_m", &o.road_height_sigma_m, CheckPositive);
   reader.Read<double>("road_height_sigma_per_m", &o.road_height_sigma_per_m, CheckNonNegative);
+  reader.Read<double>("road_crown_slope_sigma", &o.road_crown_slope_sigma, CheckNonNegative);
+  reader.Read<double>("road_crown_lateral_m", &o.road_crown_lateral_m, CheckPositive);
   reader.Read<double>("road_plane_radius_m", &o.road_plane_radius_m, CheckNonNegative);
   reader.Read<double>("lane_anchor_along_sigma_m", &o.lane_anchor_along_sigma_m, CheckPositive);
   reader.Read<double>("lane_anchor_across_sigma_m", &o.lane_anchor_across_sigma_m, CheckPositive);
@@ -195,6 +197,8 @@ std::string ToString(const BackendOptions& o) {
     << k << "max_measurements_per_marking: " << o.max_measurements_per_marking << "\n"
     << k << "road_height_sigma_m: " << o.road_height_sigma_m << "\n"
     << k << "road_height_sigma_per_m: " << o.road_height_sigma_per_m << "\n"
+    << k << "road_crown_slope_sigma: " << o.road_crown_slope_sigma << "\n"
+    << k << "road_crown_lateral_m: " << o.road_crown_lateral_m << "\n"
     << k << "road_plane_radius_m: " << o.road_plane_radius_m << "\n"
     << k << "lane_anchor_along_sigma_m: " << o.lane_anchor_along_sigma_m << "\n"
     << k << "lane_anchor_across_sigma_m: " << o.lane_anchor_across_sigma_m << "\n"

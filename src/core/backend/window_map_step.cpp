@@ -5,12 +5,14 @@
 
 #include "ipm_road_mapper/core/backend/residuals/along_lane_anchor_residual.h"
 #include "ipm_road_mapper/core/backend/residuals/corner_reprojection_residual.h"
+#include "ipm_road_mapper/core/backend/residuals/crown_slope_prior_residual.h"
 #include "ipm_road_mapper/core/backend/residuals/edge_reprojection_residual.h"
 #include "ipm_road_mapper/core/backend/residuals/extrinsic_prior_residual.h"
 #include "ipm_road_mapper/core/backend/residuals/lane_smoothness_residual.h"
 #include "ipm_road_mapper/core/backend/residuals/pose_uncertainty.h"
 #include "ipm_road_mapper/core/backend/residuals/ppsr_residual.h"
 #include "ipm_road_mapper/core/backend/residuals/psr_residual.h"
+#include "ipm_road_mapper/core/backend/residuals/road_cross_section_prior_residual.h"
 #include "ipm_road_mapper/core/backend/residuals/road_surface_prior_residual.h"
 #include "ipm_road_mapper/core/geometry/road_surface.h"
 
@@ -20,13 +22,28 @@ namespace {
 
 // The road-surface prior of a map point (road_surface_prior_residual.h): on the road plane
 // of the window's frames near it, with a sigma that grows with how far that plane is
-// extrapolated (the road is known where the wheels were, less so ahead of them).
-void AddRoadSurfacePrior(const BackendOptions& options, const WindowState& state, double* point,
+// extrapolated (the road is known where the wheels were, less so ahead of them). With
+// road_crown_slope_sigma, a point beyond road_crown_lateral_m across lies on its side's
+// plane bent by that side's crown slope (road_cross_section_prior_residual.h).
+void AddRoadSurfacePrior(const BackendOptions& options, WindowState* state, double* point,
                          ceres::Problem* problem) {
   const RoadSurfaceEstimate road = RoadSurfaceNear(
-      state.poses, Eigen::Vector3d(point[0], point[1], point[2]), options.road_plane_radius_m);
+      state->poses, Eigen::Vector3d(point[0], point[1], point[2]), options.road_plane_radius_m);
   const double sigma =
       std::hypot(options.road_height_sigma_m, options.road_height_sigma_per_m * road.distance_m);
+  const double beyond_m = std::abs(road.lateral_m) - options.road_crown_lateral_m;
+  if (options.road_crown_slope_sigma > 0.0 && road.frames > 0 && beyond_m > 0.0) {
+    double* kappa = &state->crown_slope[road.lateral_m > 0.0 ? 0 : 1];
+    if (!problem->HasParameterBlock(kappa)) {
+      problem->AddResidualBlock(
+          residuals::CrownSlopePriorResidual::Create(options.road_crown_slope_sigma), nullptr,
+          kappa);
+    }
+    problem->AddResidualBlock(
+        residuals::RoadCrossSectionPriorResidual::Create(road.plane, beyond_m, sigma), nullptr,
+        point, kappa);
+    return;
+  }
   problem->AddResidualBlock(residuals::RoadSurfacePriorResidual::Create(road.plane, sigma), nullptr,
                             point);
 }
@@ -71,7 +88,7 @@ void AddMapPointPriors(const BackendOptions& options, WindowState* state,
                                      options.lane_anchor_across_sigma_m),
                                  nullptr, c.data());
       }
-      if (options.optimize_z) AddRoadSurfacePrior(options, *state, c.data(), &problem);
+      if (options.optimize_z) AddRoadSurfacePrior(options, state, c.data(), &problem);
       ConfigurePoint(options, c.data(), &problem);
     }
   }
@@ -98,7 +115,7 @@ void AddMapPointPriors(const BackendOptions& options, WindowState* state,
           residuals::AlongLaneAnchorResidual::Create(c, tangent, options.lane_anchor_along_sigma_m,
                                                      options.lane_anchor_across_sigma_m),
           nullptr, c.data());
-      if (options.optimize_z) AddRoadSurfacePrior(options, *state, c.data(), &problem);
+      if (options.optimize_z) AddRoadSurfacePrior(options, state, c.data(), &problem);
       ConfigurePoint(options, c.data(), &problem);
     }
   }

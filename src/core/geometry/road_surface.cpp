@@ -18,13 +18,14 @@ RoadSurfaceEstimate RoadSurfaceNear(const std::vector<Eigen::Isometry3d>& T_map_
     }
     if (d <= radius_m) within.push_back(&T_map_base[i]);
   }
-  return RoadSurfaceFromPoses(within, T_map_base[closest_index], closest);
+  return RoadSurfaceFromPoses(within, T_map_base[closest_index], closest, p_map);
 }
 
 RoadSurfaceEstimate RoadSurfaceFromPoses(const std::vector<const Eigen::Isometry3d*>& within,
                                          const Eigen::Isometry3d& T_map_base_closest,
-                                         double closest_distance_m) {
+                                         double closest_distance_m, const Eigen::Vector3d& p_map) {
   RoadSurfaceEstimate estimate;
+  estimate.lateral_m = (T_map_base_closest.inverse() * p_map).y();
   Eigen::Vector3d origin_sum = Eigen::Vector3d::Zero(), normal_sum = Eigen::Vector3d::Zero();
   for (const Eigen::Isometry3d* T : within) {
     origin_sum += T->translation();

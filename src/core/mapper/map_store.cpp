@@ -313,7 +313,7 @@ RoadSurfaceEstimate MapStore::RoadSurfaceAt(const Eigen::Vector3d& p_map) const 
   for (std::size_t i : frame_index_.Within(p_map, road_plane_radius_m_)) {
     within.push_back(&map_.frames[i].T_map_base);
   }
-  return RoadSurfaceFromPoses(within, map_.frames[closest].T_map_base, closest_distance_m);
+  return RoadSurfaceFromPoses(within, map_.frames[closest].T_map_base, closest_distance_m, p_map);
 }
 
 }  // namespace ipm_road_mapper

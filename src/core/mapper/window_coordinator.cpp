@@ -1,5 +1,6 @@
 #include "ipm_road_mapper/core/mapper/window_coordinator.h"
 
+#include <algorithm>
 #include <chrono>
 #include <cmath>
 
@@ -89,7 +90,11 @@ bool WindowCoordinator::Finish(double time_budget_s) {
 
 double WindowCoordinator::RoadPriorSigma(const RoadSurfaceEstimate& road) const {
   const BackendOptions& o = options_.backend;
-  return std::hypot(o.road_height_sigma_m, o.road_height_sigma_per_m * road.distance_m);
+  // Beyond the own lane the crown's slope change (its prior, marginalized: the retired
+  // factor has no kappa of its own) widens the sigma (road_cross_section_prior_residual.h).
+  const double beyond_m = std::max(0.0, std::abs(road.lateral_m) - o.road_crown_lateral_m);
+  return std::hypot(std::hypot(o.road_height_sigma_m, o.road_height_sigma_per_m * road.distance_m),
+                    o.road_crown_slope_sigma * beyond_m);
 }
 
 }  // namespace ipm_road_mapper

@@ -101,6 +101,14 @@ struct BackendOptions {
   // the direction of travel is unobservable.
   double road_height_sigma_m = 0.02;
   double road_height_sigma_per_m = 0.01;
+  // The road's cross-section beyond the own lane (road_cross_section_prior_residual.h): a
+  // point more than road_crown_lateral_m across from that frame may lie on a plane whose
+  // slope differs from the body's by kappa, one kappa per side and solve, itself held by a
+  // zero-mean prior of this sigma (m/m). 0: off, every point on the body's plane (the planar
+  // road of the synthetic drives). Real carriageways fall 1.5-2.5 % each way from a crown
+  // at a lane line, so the lines across it lie below the body's plane (docs/backend.md).
+  double road_crown_slope_sigma = 0.0;
+  double road_crown_lateral_m = 2.0;
   // The road's plane at a point averages the frames that drove within this radius of it
   // (road_surface.h: the body's pitch oscillation averages out over a period, ~10 m).
   double road_plane_radius_m = 6.0;

@@ -79,6 +79,9 @@ struct WindowState {
   std::vector<CornerMeasurement> corner_measurements;
   std::vector<EdgeMeasurement> edge_measurements;
   PoseBlocks held_extrinsic;  // the extrinsic as partial-only markings see it (held)
+  // The road's slope change beyond the own lane, left and right of the vehicle
+  // (BackendOptions::road_crown_slope_sigma; road_cross_section_prior_residual.h).
+  std::array<double, 2> crown_slope{{0.0, 0.0}};
   std::vector<LanePixel> lane_pixels;
   std::vector<Eigen::Isometry3d> poses;  // the frames' poses at the start (road surface)
   std::vector<bool> optimized;           // free in a pose step (WindowFrame::optimized)

@@ -21,6 +21,7 @@ struct RoadPlane {
 struct RoadSurfaceEstimate {
   RoadPlane plane;
   double distance_m = 0.0;  // horizontal distance from p_map to the closest frame used
+  double lateral_m = 0.0;   // p_map's offset along that frame's base_link y (left > 0)
   int frames = 0;           // frames averaged (0: no pose at all)
 };
 
@@ -33,6 +34,6 @@ RoadSurfaceEstimate RoadSurfaceNear(const std::vector<Eigen::Isometry3d>& T_map_
 // frame order; may be empty) and the closest pose with its horizontal distance.
 RoadSurfaceEstimate RoadSurfaceFromPoses(const std::vector<const Eigen::Isometry3d*>& within,
                                          const Eigen::Isometry3d& T_map_base_closest,
-                                         double closest_distance_m);
+                                         double closest_distance_m, const Eigen::Vector3d& p_map);
 
 }  // namespace ipm_road_mapper
