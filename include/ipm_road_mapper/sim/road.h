@@ -95,7 +95,8 @@ class RoadModel {
 class SightProfile {
  public:
   SightProfile() = default;  // sees everything
-  // Samples the profile from the camera's s to s + range_m every `step_m`.
+  // Samples the profile from the camera's s to s + range_m every `step_m`. Keeps a pointer to
+  // `road` (its cross-section, RoadModel::CrossHeight): the road must outlive the profile.
   SightProfile(const RoadModel& road, const Eigen::Vector3d& p_map_cam, double s_hint,
                double range_m, double step_m = 0.25);
 
