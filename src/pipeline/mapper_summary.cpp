@@ -4,6 +4,7 @@
 #include <sstream>
 
 #include "ipm_road_mapper/core/backend/extrinsic_observability.h"
+#include "ipm_road_mapper/core/frontend/class_size_check.h"
 #include "ipm_road_mapper/core/geometry/rigid_transform.h"
 #include "ipm_road_mapper/core/mapper/timing_series.h"
 
@@ -32,8 +33,11 @@ std::string MapperSummaryLines(const Mapper& mapper, const FrameAssembler& assem
     << " lanes doubling back (" << e.lane_rows_doubled
     << " lane rows of several runs), frames without observations: " << e.frames_too_many_instances
     << " too many instances, " << e.frames_too_much_coverage << " too much coverage ("
-    << e.dropped_absurd_frame << " instances); odometry reordered " << a.odometry_reordered << "\n"
-    << "map: " << map.markings.size() << " markings, " << map.lanes.size() << " lanes (created "
+    << e.dropped_absurd_frame << " instances); odometry reordered " << a.odometry_reordered << "\n";
+  for (const OversizedClass& suspect : MostlyOversizedClasses(e, mapper.classes())) {
+    s << "warning: " << Describe(suspect) << "\n";
+  }
+  s << "map: " << map.markings.size() << " markings, " << map.lanes.size() << " lanes (created "
     << c.markings_created << " markings, " << c.lanes_created << " lanes; spurious dropped "
     << c.spurious_dropped << ", lanes merged " << c.lanes_merged << ", joined " << c.lanes_joined
     << " (" << c.lanes_joined_hidden_gap << " across a gap out of view)"

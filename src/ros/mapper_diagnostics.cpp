@@ -73,6 +73,8 @@ void FillFrameStatus(const MapperStatusSnapshot& now, const MapperStatusSnapshot
   s->add("lane rows crossing their instance twice", e.lane_rows_doubled);
   s->add("lane observations along a lane of another class (class flicker)",
          now.counters.lane_observations_other_class);
+  s->add("marking views dropped: oversized", e.dropped_oversized);
+  for (const std::string& warning : now.class_table_warnings) s->add("class table", warning);
   s->addf("callback time mean (ms)", "%.3f", now.callback_mean_ms);
   s->addf("callback time max (ms)", "%.3f", now.callback_max_ms);
   s->addf("frame callback time mean (ms)", "%.3f", now.frame_callback_mean_ms);
@@ -110,6 +112,10 @@ void FillFrameStatus(const MapperStatusSnapshot& now, const MapperStatusSnapshot
                "masks or odometry lost before the callbacks (subscriber queue full?)");
   } else if (new_used == 0 && new_skipped > 0) {
     s->summary(DiagnosticStatus::WARN, "frames skipped, none used");
+  } else if (!now.class_table_warnings.empty()) {
+    s->summary(DiagnosticStatus::WARN,
+               "most views of a marking class exceed its size bounds: is the class table the "
+               "masks' own?");
   } else if (new_skipped > 0) {
     s->summary(DiagnosticStatus::OK, "mapping (some frames skipped)");
   } else {

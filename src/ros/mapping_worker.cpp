@@ -5,6 +5,7 @@
 #include <algorithm>
 #include <utility>
 
+#include "ipm_road_mapper/core/frontend/class_size_check.h"
 #include "ipm_road_mapper/core/mapper/lane_topology.h"
 #include "ipm_road_mapper/ros/map_publisher.h"
 
@@ -346,6 +347,10 @@ MapperStatusSnapshot MappingWorker::Status() const {
     s.T_base_cam = mapper->T_base_cam();
     s.T_base_cam_covariance = mapper->T_base_cam_covariance();
     s.extrinsic_observed = mapper->extrinsic_observed();
+    for (const OversizedClass& suspect :
+         MostlyOversizedClasses(s.counters.extraction, mapper->classes())) {
+      s.class_table_warnings.push_back(Describe(suspect));
+    }
   }
   return s;
 }

@@ -49,6 +49,26 @@ TEST(MapperDiagnostics, SkipReasonsAndSyncDrops) {
   EXPECT_EQ(warn.level, DiagnosticStatus::WARN);
 }
 
+TEST(MapperDiagnostics, AClassTableThatIsNotTheMasksOwnWarns) {
+  MapperStatusSnapshot previous, now;
+  now.started = true;
+  now.counters.frames_used = 90;
+  now.counters.extraction.dropped_oversized = 158;
+  previous = now;
+  previous.counters.frames_used = 80;
+  DiagnosticStatusWrapper ok;
+  FillFrameStatus(now, previous, Flowing(), &ok);
+  EXPECT_EQ(ok.level, DiagnosticStatus::OK);
+  EXPECT_EQ(Value(ok, "marking views dropped: oversized"), "158");
+  EXPECT_EQ(Value(ok, "class table"), "<missing>");
+  now.class_table_warnings = {"class 10 'arrow_straight' (at most 10.0 x 4.0 m): 158 of 236"};
+  DiagnosticStatusWrapper warn;
+  FillFrameStatus(now, previous, Flowing(), &warn);
+  EXPECT_EQ(warn.level, DiagnosticStatus::WARN);
+  EXPECT_NE(warn.message.find("class table"), std::string::npos) << warn.message;
+  EXPECT_EQ(Value(warn, "class table"), now.class_table_warnings[0]);
+}
+
 TEST(MapperDiagnostics, QueueDropsWarnAndPublishCpuIsShown) {
   MapperStatusSnapshot previous, now;
   now.started = true;

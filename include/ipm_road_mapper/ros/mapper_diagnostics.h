@@ -24,6 +24,7 @@
 #include <map>
 #include <mutex>
 #include <string>
+#include <vector>
 
 #include "ipm_road_mapper/core/backend/backend.h"
 #include "ipm_road_mapper/core/mapper/mapper.h"
@@ -66,6 +67,9 @@ struct MapperStatusSnapshot {
   // Its covariance (roll, pitch, yaw in rad, x, y, z in m) and the axes the data observed.
   Eigen::Matrix<double, 6, 6> T_base_cam_covariance = Eigen::Matrix<double, 6, 6>::Zero();
   std::array<bool, 6> extrinsic_observed{};
+  // Marking classes whose views mostly exceed their size bounds (class_size_check.h), one
+  // line each: the class table may not be the masks' own.
+  std::vector<std::string> class_table_warnings;
   std::uint64_t callbacks = 0;                                       // data callbacks timed
   double callback_mean_ms = 0.0, callback_max_ms = 0.0;              // every data callback
   double frame_callback_mean_ms = 0.0, frame_callback_max_ms = 0.0;  // mask + camera_info ones

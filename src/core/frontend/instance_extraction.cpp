@@ -252,6 +252,13 @@ FrameObservations ExtractObservations(const cv::Mat& mask, const ClassTable& cla
       marking.pixel_count = stats.pixel_count;
       outcome = extraction::ExtractMarking(runs, stats.run_count, mask, stats.value, classes, ipm,
                                            error_model, options, &marking);
+      if (outcome == GeometryOutcome::kOk || outcome == GeometryOutcome::kTruncated ||
+          outcome == GeometryOutcome::kOversized) {
+        ++counters.markings_sized_by_class[marking.class_id];
+        if (outcome == GeometryOutcome::kOversized) {
+          ++counters.markings_oversized_by_class[marking.class_id];
+        }
+      }
       if (outcome == GeometryOutcome::kOk) {
         if (!marking.Complete()) ++counters.partial_markings;
         observations.markings.push_back(std::move(marking));

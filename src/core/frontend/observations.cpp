@@ -19,6 +19,10 @@ void ExtractionCounters::Add(const ExtractionCounters& o) {
   lane_runs_too_wide += o.lane_runs_too_wide;
   frames_too_many_instances += o.frames_too_many_instances;
   frames_too_much_coverage += o.frames_too_much_coverage;
+  for (int i = 0; i < kClassIdSlots; ++i) {
+    markings_sized_by_class[i] += o.markings_sized_by_class[i];
+    markings_oversized_by_class[i] += o.markings_oversized_by_class[i];
+  }
 }
 
 }  // namespace ipm_road_mapper

@@ -66,6 +66,9 @@ struct LaneObservation {
   int pixel_count = 0;
 };
 
+// Slots of the per-class counters below: one per class id 0..65 (kMaxClassId, class_table.h).
+constexpr int kClassIdSlots = 66;
+
 // Why an instance (or a whole mask) was not used; counted, never silent.
 struct ExtractionCounters {
   std::uint64_t instances_seen = 0;
@@ -86,6 +89,11 @@ struct ExtractionCounters {
   // more than a quarter of such rows (one that doubles back): dropped.
   std::uint64_t lane_rows_doubled = 0;
   std::uint64_t dropped_doubled_lane = 0;
+  // Per marking class id: the views whose size was judged against the class's bounds (kept,
+  // truncated or oversized), and those of them larger than the bounds. A class table that is
+  // not the masks' own shows here (class_size_check.h).
+  std::array<std::uint64_t, kClassIdSlots> markings_sized_by_class{};
+  std::array<std::uint64_t, kClassIdSlots> markings_oversized_by_class{};
   void Add(const ExtractionCounters& o);
 };
 
