@@ -1,13 +1,12 @@
 #include "ipm_road_mapper/core/io/geojson_export.h"
 
-#include <GeographicLib/LocalCartesian.hpp>
 #include <algorithm>
 #include <array>
 #include <cmath>
 #include <stdexcept>
 #include <vector>
 
-#include "ipm_road_mapper/core/geometry/catmull_rom_spline.h"
+#include "ipm_road_mapper/core/io/map_geodesy.h"
 #include "json_io.h"
 
 namespace ipm_road_mapper {
@@ -29,34 +28,24 @@ constexpr int kGeoJsonIndent = 1;
 class PositionConverter {
  public:
   explicit PositionConverter(const std::optional<GeoOrigin>& origin) {
-    if (origin) {
-      local_cartesian_.emplace(origin->latitude_deg, origin->longitude_deg, origin->altitude_m);
-      const double heading = origin->heading_deg * M_PI / 180.0;
-      cos_heading_ = std::cos(heading);
-      sin_heading_ = std::sin(heading);
-    }
+    if (origin) to_wgs84_.emplace(*origin);
   }
 
-  // [lon, lat, alt] with an origin (the map point turned by the heading into east, north,
-  // up), else [x, y, z].
+  // [lon, lat, alt] with an origin, else [x, y, z].
   nlohmann::json Position(const Eigen::Vector3d& p_map) const {
-    if (!local_cartesian_) return Rounded(p_map, kMetricScale);
-    const double east = cos_heading_ * p_map.x() - sin_heading_ * p_map.y();
-    const double north = sin_heading_ * p_map.x() + cos_heading_ * p_map.y();
-    double latitude_deg = 0.0, longitude_deg = 0.0, altitude_m = 0.0;
-    local_cartesian_->Reverse(east, north, p_map.z(), latitude_deg, longitude_deg, altitude_m);
-    return nlohmann::json::array({Round(longitude_deg, kDegreeScale),
-                                  Round(latitude_deg, kDegreeScale),
-                                  Round(altitude_m, kMetricScale)});
+    if (!to_wgs84_) return Rounded(p_map, kMetricScale);
+    const Wgs84Point p = to_wgs84_->Convert(p_map);
+    return nlohmann::json::array({Round(p.longitude_deg, kDegreeScale),
+                                  Round(p.latitude_deg, kDegreeScale),
+                                  Round(p.altitude_m, kMetricScale)});
   }
 
   const char* CoordinateSystem() const {
-    return local_cartesian_ ? kCoordinateSystemWgs84 : kCoordinateSystemLocal;
+    return to_wgs84_ ? kCoordinateSystemWgs84 : kCoordinateSystemLocal;
   }
 
  private:
-  std::optional<GeographicLib::LocalCartesian> local_cartesian_;
-  double cos_heading_ = 1.0, sin_heading_ = 0.0;
+  std::optional<MapToWgs84> to_wgs84_;
 };
 
 // Twice the signed area of the polygon's x-y projection (> 0: counter-clockwise from above).
@@ -94,26 +83,13 @@ nlohmann::json MarkingFeature(const MapMarking& marking, const PositionConverter
           {"properties", properties}};
 }
 
-// Points of the lane's LineString (see the header for the fallbacks).
-std::vector<Eigen::Vector3d> LanePolyline(const MapLane& lane) {
-  if (lane.control_points_map.size() >= 4) {
-    try {
-      return CatmullRomSpline(lane.control_points_map).SampleByArcLength(kLaneSampleSpacing_m);
-    } catch (const std::invalid_argument&) {
-      return {};  // a non-finite control point: no geometry rather than a broken one
-    }
-  }
-  if (lane.control_points_map.size() >= 2) return lane.control_points_map;
-  return {};
-}
-
 nlohmann::json LaneFeature(const MapLane& lane, const PositionConverter& converter) {
   nlohmann::json control_points = nlohmann::json::array();
   for (const Eigen::Vector3d& c_map : lane.control_points_map) {
     control_points.push_back(Rounded(c_map, kMetricScale));
   }
   nlohmann::json geometry = nullptr;
-  const std::vector<Eigen::Vector3d> polyline = LanePolyline(lane);
+  const std::vector<Eigen::Vector3d> polyline = LanePolyline(lane, kLaneSampleSpacing_m);
   if (polyline.size() >= 2) {
     nlohmann::json positions = nlohmann::json::array();
     for (const Eigen::Vector3d& p_map : polyline) positions.push_back(converter.Position(p_map));
