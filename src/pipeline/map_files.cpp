@@ -57,7 +57,7 @@ MapFilePaths MapFilePathsFor(const std::string& json_path) {
       stem.compare(stem.size() - suffix.size(), suffix.size(), suffix) == 0) {
     stem.resize(stem.size() - suffix.size());
   }
-  return {stem + ".json", stem + ".geojson", stem + "_trajectory_tum.txt"};
+  return {stem + ".json", stem + ".geojson", stem + "_trajectory_tum.txt", stem + ".osm"};
 }
 
 MapFilePaths MapFilePathsInFolder(const std::string& folder) {
@@ -72,10 +72,15 @@ MapFilePaths MapFilePathsAfterReset(const std::string& json_path, std::uint64_t 
 
 std::string SaveMapFiles(const VectorMap& map, const std::optional<GeoOrigin>& geo_origin,
                          const MapFilePaths& paths) {
-  for (const std::string* path : {&paths.json, &paths.geojson, &paths.tum}) CreateParent(*path);
+  for (const std::string* path : {&paths.json, &paths.geojson, &paths.tum, &paths.osm}) {
+    CreateParent(*path);
+  }
   std::vector<std::pair<std::string, std::string>> moves = {
       {TemporarySibling(paths.json), paths.json}};  // temporary -> final, in rename order
-  if (geo_origin) moves.emplace_back(TemporarySibling(paths.geojson), paths.geojson);
+  if (geo_origin) {
+    moves.emplace_back(TemporarySibling(paths.geojson), paths.geojson);
+    moves.emplace_back(TemporarySibling(paths.osm), paths.osm);
+  }
   moves.emplace_back(TemporarySibling(paths.tum), paths.tum);
   auto remove_temporaries = [&] {
     for (const auto& move : moves) std::remove(move.first.c_str());
@@ -85,7 +90,10 @@ std::string SaveMapFiles(const VectorMap& map, const std::optional<GeoOrigin>& g
     VectorMap recorded = map;  // the JSON records the origin the GeoJSON was made with
     recorded.geo_origin = geo_origin;
     SaveVectorMapJson(recorded, moves.front().first);
-    if (geo_origin) SaveGeoJson(map, geo_origin, moves[1].first);
+    if (geo_origin) {
+      SaveGeoJson(map, geo_origin, moves[1].first);
+      SaveLanelet2Osm(map, *geo_origin, moves[2].first);
+    }
     WriteTumTrajectory(map.trajectory, moves.back().first);
   } catch (const std::exception& e) {
     remove_temporaries();
@@ -105,12 +113,20 @@ std::string SaveMapFiles(const VectorMap& map, const std::optional<GeoOrigin>& g
       throw std::runtime_error(to + ": cannot rename the temporary file into place: " + reason);
     }
   }
-  std::error_code ignored;  // a stale GeoJSON that cannot be removed is left, not fatal
-  if (!geo_origin) fs::remove(paths.geojson, ignored);
+  std::error_code ignored;  // a stale export that cannot be removed is left, not fatal
+  if (!geo_origin) {
+    fs::remove(paths.geojson, ignored);
+    fs::remove(paths.osm, ignored);
+  }
   std::set<std::string> folders;
   for (const auto& move : moves) folders.insert(fs::path(move.second).parent_path().string());
   for (const std::string& folder : folders) SyncFolder((fs::path(folder) / "x").string());
   return geo_origin ? "" : kNoGeoJsonNote;
+}
+
+std::string SavedFilesText(const MapFilePaths& paths, bool with_exports) {
+  return paths.json + ", " + (with_exports ? paths.geojson + ", " + paths.osm + ", " : "") +
+         paths.tum;
 }
 
 std::size_t MapElementCount(const VectorMap& map) { return map.markings.size() + map.lanes.size(); }

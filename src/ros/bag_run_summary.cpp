@@ -49,8 +49,8 @@ std::string BagRunSummary(const BagRunPaths& paths, const Mapper& mapper,
     << (stats.wall_s > 0 ? stats.frames_read / stats.wall_s : 0.0) << " frames/s; bag span "
     << stats.bag_span_s << " s; real-time factor "
     << (stats.wall_s > 0 ? stats.bag_span_s / stats.wall_s : 0.0) << "x\n"
-    << "outputs: " << paths.out << "/{map.json, " << (map.geo_origin ? "map.geojson, " : "")
-    << "map_trajectory_tum.txt, summary.txt}"
+    << "outputs: " << paths.out << "/{map.json, "
+    << (map.geo_origin ? "map.geojson, map.osm, " : "") << "map_trajectory_tum.txt, summary.txt}"
     << (paths.stats_out.empty() ? "" : ", " + paths.stats_out)
     << (paths.calibration_out.empty() ? "" : ", " + paths.calibration_out) << "\n";
   return s.str();

@@ -120,8 +120,8 @@ MapSaveResult MapSaver::Save(const VectorMap& map, std::uint64_t generation) {
     target_.Saved(generation, elements);
     result.ok = true;
     result.message = std::to_string(map.markings.size()) + " markings, " +
-                     std::to_string(map.lanes.size()) + " lanes to " + result.paths.json + ", " +
-                     result.paths.geojson + ", " + result.paths.tum;
+                     std::to_string(map.lanes.size()) + " lanes to " +
+                     SavedFilesText(result.paths, geo_origin_.has_value());
     if (result.diverted) {
       result.message += " (after ~reset " + std::to_string(generation) +
                         ": fewer elements than the last save, which " + target_.json_path() +

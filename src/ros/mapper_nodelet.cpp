@@ -261,8 +261,8 @@ bool MapperNodelet::OnSaveMap(ipm_road_mapper::SaveMap::Request& request,
       SaveMapFiles(map, config_.geo_origin, paths);
       response.success = true;
       response.message = "wrote " + std::to_string(map.markings.size()) + " markings and " +
-                         std::to_string(map.lanes.size()) + " lanes to " + paths.json + ", " +
-                         paths.geojson + ", " + paths.tum;
+                         std::to_string(map.lanes.size()) + " lanes to " +
+                         SavedFilesText(paths, config_.geo_origin.has_value());
     } catch (const std::exception& e) {
       response.message = e.what();
     }

@@ -14,7 +14,8 @@
 // first messages), pairs each mask with its camera_info (CameraInfoPairing; sync exact:
 // identical stamp; approximate: nearest within half the period of the first camera_infos)
 // and with odometry interpolated at its stamp (FrameAssembler, the same code the nodelet
-// uses), runs the core Mapper, and writes <dir>/map.json, <dir>/map.geojson,
+// uses), runs the core Mapper, and writes <dir>/map.json, <dir>/map.geojson and <dir>/map.osm
+// (Lanelet2; both only with a geo_origin),
 // <dir>/map_trajectory_tum.txt and <dir>/summary.txt (with startup_s: process start to the first
 // frame mapped), with --stats-out a CSV row per frame (CPU time, RSS), and with
 // --publish-stats-out the publication's CPU per publish near each km (PublishCostProbe); under

@@ -68,24 +68,31 @@ TEST(MapFiles, OneNamingRuleForFilesAndFolders) {
   EXPECT_EQ(in_folder.json, "/o/run/map.json");
   EXPECT_EQ(in_folder.geojson, "/o/run/map.geojson");
   EXPECT_EQ(in_folder.tum, "/o/run/map_trajectory_tum.txt");  // as MapFilePathsFor(map.json)
+  EXPECT_EQ(in_folder.osm, "/o/run/map.osm");
   EXPECT_EQ(MapFilePathsFor("/o/run/map.json").tum, in_folder.tum);
 
   const MapFilePaths reset = MapFilePathsAfterReset("/tmp/live.json", 2);
   EXPECT_EQ(reset.json, "/tmp/live_reset2.json");
   EXPECT_EQ(reset.geojson, "/tmp/live_reset2.geojson");
   EXPECT_EQ(reset.tum, "/tmp/live_reset2_trajectory_tum.txt");
+  EXPECT_EQ(reset.osm, "/tmp/live_reset2.osm");
+  EXPECT_EQ(SavedFilesText(reset, true),
+            "/tmp/live_reset2.json, /tmp/live_reset2.geojson, "
+            "/tmp/live_reset2.osm, /tmp/live_reset2_trajectory_tum.txt");
+  EXPECT_EQ(SavedFilesText(reset, false),
+            "/tmp/live_reset2.json, /tmp/live_reset2_trajectory_tum.txt");
   EXPECT_EQ(MapFilePathsAfterReset("/tmp/live", 1).json, "/tmp/live_reset1.json");
 }
 
 const GeoOrigin kOrigin{48.0, 11.0, 500.0};
 
-TEST(MapFiles, SaveWritesExactlyTheThreeFilesWithAnOrigin) {
+TEST(MapFiles, SaveWritesExactlyTheFourFilesWithAnOrigin) {
   const std::string dir = TempFolder("three");
   const VectorMap map = MapWith(2, 1);
   EXPECT_EQ(SaveMapFiles(map, kOrigin, MapFilePathsFor(dir + "/m.json")), "");
   EXPECT_EQ(SaveMapFiles(map, kOrigin, MapFilePathsFor(dir + "/m.json")), "");  // over them
-  EXPECT_EQ(FilesIn(dir),
-            (std::set<std::string>{"m.json", "m.geojson", "m_trajectory_tum.txt"}));  // no temp
+  EXPECT_EQ(FilesIn(dir), (std::set<std::string>{"m.json", "m.geojson", "m.osm",
+                                                 "m_trajectory_tum.txt"}));  // no temporary left
   const VectorMap loaded = LoadVectorMapJson(dir + "/m.json");
   EXPECT_EQ(loaded.markings.size(), 2u);
   EXPECT_EQ(loaded.lanes.size(), 1u);
@@ -94,16 +101,18 @@ TEST(MapFiles, SaveWritesExactlyTheThreeFilesWithAnOrigin) {
   EXPECT_EQ(loaded.geo_origin->longitude_deg, 11.0);
   EXPECT_EQ(loaded.geo_origin->altitude_m, 500.0);
   EXPECT_NE(Read(dir + "/m.geojson").find("wgs84"), std::string::npos);
+  EXPECT_NE(Read(dir + "/m.osm").find("<tag k=\"type\" v=\"line_thin\"/>"), std::string::npos);
   EXPECT_FALSE(Read(dir + "/m_trajectory_tum.txt").empty());
 }
 
-// Without an origin the GeoJSON would hold local metres read as degrees: none is written,
-// the caller is told why, and one left by an earlier save with an origin is removed.
+// Without an origin the GeoJSON and the OSM would hold local metres read as degrees: none is
+// written, the caller is told why, and those left by an earlier save with an origin are removed.
 TEST(MapFiles, NoGeoJsonWithoutAnOriginAndAStaleOneIsRemoved) {
   const std::string dir = TempFolder("no_origin");
   const MapFilePaths paths = MapFilePathsFor(dir + "/m.json");
   EXPECT_EQ(SaveMapFiles(MapWith(2, 1), kOrigin, paths), "");
   ASSERT_TRUE(fs::exists(paths.geojson));
+  ASSERT_TRUE(fs::exists(paths.osm));
   const std::string note = SaveMapFiles(MapWith(2, 1), std::nullopt, paths);
   EXPECT_EQ(note, kNoGeoJsonNote);
   EXPECT_NE(note.find("geo_origin"), std::string::npos);
@@ -116,7 +125,8 @@ TEST(MapFiles, AFailedSaveReplacesNothingAndNamesTheRealFile) {
   const std::string dir = TempFolder("failed");
   const MapFilePaths paths = MapFilePathsFor(dir + "/m.json");
   SaveMapFiles(MapWith(3, 2), kOrigin, paths);
-  const std::string json = Read(paths.json), geojson = Read(paths.geojson), tum = Read(paths.tum);
+  const std::string json = Read(paths.json), geojson = Read(paths.geojson), tum = Read(paths.tum),
+                    osm = Read(paths.osm);
 
   VectorMap bad = MapWith(1, 1);  // the map writer refuses what its reader would reject
   bad.markings[0].corners_map[0].x() = std::numeric_limits<double>::quiet_NaN();
@@ -131,7 +141,8 @@ TEST(MapFiles, AFailedSaveReplacesNothingAndNamesTheRealFile) {
   EXPECT_EQ(Read(paths.json), json);
   EXPECT_EQ(Read(paths.geojson), geojson);
   EXPECT_EQ(Read(paths.tum), tum);
-  EXPECT_EQ(FilesIn(dir).size(), 3u);  // the temporaries are gone
+  EXPECT_EQ(Read(paths.osm), osm);
+  EXPECT_EQ(FilesIn(dir).size(), 4u);  // the temporaries are gone
 }
 
 TEST(MapFiles, AnUnwritableFolderThrowsWithTheFolder) {

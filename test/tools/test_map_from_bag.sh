@@ -131,8 +131,9 @@ if run_mapper --bag "$work/drive.bag" --out "$work/out" >"$work/summary.log" 2>"
     [ -s "$work/out/$file" ] || fail "$file missing or empty"
   done
   [ ! -e "$work/out/map.geojson" ] || fail "map.geojson written without a geo_origin"
-  [ "$(grep -c "^no GeoJSON: no geo_origin in the config" "$work/summary.log")" = 1 ] \
-    || fail "no single 'no GeoJSON' line on stdout"
+  [ ! -e "$work/out/map.osm" ] || fail "map.osm written without a geo_origin"
+  [ "$(grep -c "^no GeoJSON, no Lanelet2 OSM: no geo_origin in the config" "$work/summary.log")" = 1 ] \
+    || fail "no single 'no GeoJSON, no Lanelet2 OSM' line on stdout"
   grep -q "^outputs: .*map.geojson" "$work/out/summary.txt" && fail "summary lists map.geojson"
   grep -q "^frames read: 25$" "$work/out/summary.txt" || fail "summary: frames read is not 25"
   grep -q "^frames used: 25$" "$work/out/summary.txt" || fail "summary: not all 25 frames used"
@@ -166,6 +167,26 @@ geo_config=$(overlay geo.yaml "geo_origin: {latitude_deg: 48.0, longitude_deg: 1
 if run_mapper --bag "$work/drive.bag" --config "$geo_config" --out "$work/geo" >"$work/geo.log" 2>&1; then
   check_geojson "$work/geo/map.geojson" wgs84 || fail "map.geojson (wgs84) checks"
   grep -q "no GeoJSON" "$work/geo.log" && fail "'no GeoJSON' printed with a geo_origin"
+  # The Lanelet2 OSM: well-formed XML whose references resolve, the drive's lane a line string.
+  /usr/bin/python3 - "$work/geo/map.osm" <<'EOF' && pass "map.osm (Lanelet2) checks" || fail "map.osm (Lanelet2) checks"
+import sys, xml.etree.ElementTree as ET
+root = ET.parse(sys.argv[1]).getroot()
+assert root.tag == "osm" and root.get("version") == "0.6", root.attrib
+nodes = {n.get("id"): n for n in root.findall("node")}
+ways = {w.get("id"): w for w in root.findall("way")}
+assert nodes and ways, "no nodes or ways"
+for w in ways.values():
+    refs = [nd.get("ref") for nd in w.findall("nd")]
+    assert len(refs) >= 2 and all(r in nodes for r in refs), w.get("id")
+for r in root.findall("relation"):
+    assert all(m.get("ref") in ways for m in r.findall("member")), r.get("id")
+for n in nodes.values():
+    lat, lon = float(n.get("lat")), float(n.get("lon"))
+    assert abs(lat - 48.0) < 0.01 and abs(lon - 11.0) < 0.01, (lat, lon)
+lines = [w for w in ways.values() if any(t.get("k") == "type" and t.get("v") == "line_thin" for t in w.findall("tag"))]
+assert lines, "no lane line string"
+print("ok: map.osm: %d nodes, %d ways (%d lane line pieces), %d lanelets" % (len(nodes), len(ways), len(lines), len(root.findall("relation"))))
+EOF
   /usr/bin/python3 -c '
 import json, sys
 o = json.load(open(sys.argv[1]))["geo_origin"]
@@ -176,7 +197,7 @@ assert o == {"latitude_deg": 48.0, "longitude_deg": 11.0, "altitude_m": 500.0,
   cp -r "$work/geo" "$work/stale"
   plain_config=$(overlay plain.yaml)
   if run_mapper --bag "$work/drive.bag" --config "$plain_config" --out "$work/stale" >/dev/null 2>&1 &&
-     [ ! -e "$work/stale/map.geojson" ]; then
+     [ ! -e "$work/stale/map.geojson" ] && [ ! -e "$work/stale/map.osm" ]; then
     pass "a stale map.geojson is removed by a run without geo_origin"
   else
     fail "stale map.geojson left (or the run failed)"

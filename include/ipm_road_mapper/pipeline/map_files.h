@@ -1,9 +1,10 @@
 // Writing a finished map to disk, the same way for the offline runner (map_from_bag --out)
-// and the nodelet (~save_map, the autosave and at shutdown): the map JSON, its GeoJSON (only
-// with a geo origin) and the corrected trajectory in TUM format, named by one rule
-// (MapFilePathsFor). A save is atomic per file and all-or-nothing for the three: each is written
-// and fsynced under a temporary name in its own folder first, then the three are renamed into
-// place. Also the rule that keeps a live map saved before a ~reset (MapSaveTarget). No ROS header.
+// and the nodelet (~save_map, the autosave and at shutdown): the map JSON, its GeoJSON and
+// Lanelet2 OSM exports (only with a geo origin) and the corrected trajectory in TUM format,
+// named by one rule (MapFilePathsFor). A save is atomic per file and all-or-nothing for the
+// files: each is written and fsynced under a temporary name in its own folder first, then they
+// are renamed into place. Also the rule that keeps a live map saved before a ~reset
+// (MapSaveTarget). No ROS header.
 #pragma once
 
 #include <cstddef>
@@ -13,6 +14,7 @@
 #include <string>
 
 #include "ipm_road_mapper/core/io/geojson_export.h"
+#include "ipm_road_mapper/core/io/lanelet2_export.h"
 #include "ipm_road_mapper/core/map/vector_map.h"
 
 namespace ipm_road_mapper {
@@ -22,11 +24,12 @@ struct MapFilePaths {
   std::string json;     // the map (docs/file_formats.md)
   std::string geojson;  // RFC 7946 export (written only with a geo origin)
   std::string tum;      // corrected T_map_base per used frame
+  std::string osm;      // Lanelet2 OSM export (written only with a geo origin)
 };
 
-// The files of a map saved as `json_path`: "<stem>.json", "<stem>.geojson" and
-// "<stem>_trajectory_tum.txt", where <stem> is json_path without a trailing ".json".
-// Example: /tmp/m.json -> /tmp/m.geojson, /tmp/m_trajectory_tum.txt.
+// The files of a map saved as `json_path`: "<stem>.json", "<stem>.geojson",
+// "<stem>_trajectory_tum.txt" and "<stem>.osm", where <stem> is json_path without a trailing
+// ".json". Example: /tmp/m.json -> /tmp/m.geojson, /tmp/m_trajectory_tum.txt, /tmp/m.osm.
 MapFilePaths MapFilePathsFor(const std::string& json_path);
 
 // The files of map_from_bag's output folder, by the same rule: map.json, map.geojson,
@@ -37,20 +40,25 @@ MapFilePaths MapFilePathsInFolder(const std::string& folder);
 // `json_path`: "<stem>_reset<reset>.json" and its siblings (MapFilePathsFor).
 MapFilePaths MapFilePathsAfterReset(const std::string& json_path, std::uint64_t reset);
 
-// Why SaveMapFiles wrote no GeoJSON when it had no geo origin.
+// Why SaveMapFiles wrote no GeoJSON and no Lanelet2 OSM when it had no geo origin.
 constexpr const char* kNoGeoJsonNote =
-    "no GeoJSON: no geo_origin in the config (local metres are not WGS84)";
+    "no GeoJSON, no Lanelet2 OSM: no geo_origin in the config (local metres are not WGS84)";
 
 // Creates the parent folders and writes the map files: the JSON (with `geo_origin` recorded
-// when there is one), the TUM trajectory and, only with a geo origin, the GeoJSON in WGS84.
-// All under temporary names (each fsynced), then renamed into place (json, geojson, tum: the
-// TUM file is the last to appear) and the folders fsynced. Without an origin a stale
-// `paths.geojson` of an earlier save is removed, so the folder never holds a GeoJSON that
-// disagrees with the JSON. When any file cannot be written, none of the existing files is
-// replaced. Returns "" when all three were written, else one line saying why the GeoJSON
-// was not (kNoGeoJsonNote). Throws std::runtime_error naming the file and the reason.
+// when there is one), the TUM trajectory and, only with a geo origin, the GeoJSON in WGS84
+// and the Lanelet2 OSM (lanelet2_export.h). All under temporary names (each fsynced), then
+// renamed into place (json, geojson, osm, tum: the TUM file is the last to appear) and the
+// folders fsynced. Without an origin a stale `paths.geojson` and `paths.osm` of an earlier
+// save are removed, so the folder never holds an export that disagrees with the JSON. When
+// any file cannot be written, none of the existing files is replaced. Returns "" when every
+// file was written, else one line saying why the exports were not (kNoGeoJsonNote). Throws
+// std::runtime_error naming the file and the reason.
 std::string SaveMapFiles(const VectorMap& map, const std::optional<GeoOrigin>& geo_origin,
                          const MapFilePaths& paths);
+
+// The files SaveMapFiles writes, comma-separated: the exports only `with_exports` (a geo
+// origin).
+std::string SavedFilesText(const MapFilePaths& paths, bool with_exports);
 
 // Markings + lanes: what "a map with fewer elements" counts.
 std::size_t MapElementCount(const VectorMap& map);
