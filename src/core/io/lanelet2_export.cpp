@@ -254,8 +254,9 @@ std::string VectorMapToLanelet2Osm(const VectorMap& map, const GeoOrigin& origin
   return osm.Document();
 }
 
-void SaveLanelet2Osm(const VectorMap& map, const GeoOrigin& origin, const std::string& path) {
-  json_io::WriteFileAtomically(path, VectorMapToLanelet2Osm(map, origin));
+void SaveLanelet2Osm(const VectorMap& map, const GeoOrigin& origin, const std::string& path,
+                     Lanelet2ExportStats* stats) {
+  json_io::WriteFileAtomically(path, VectorMapToLanelet2Osm(map, origin, stats));
 }
 
 }  // namespace ipm_road_mapper

@@ -44,6 +44,7 @@ std::string VectorMapToLanelet2Osm(const VectorMap& map, const GeoOrigin& origin
 
 // Writes VectorMapToLanelet2Osm atomically (temporary file + rename, fsynced). Throws
 // std::runtime_error when the file cannot be written.
-void SaveLanelet2Osm(const VectorMap& map, const GeoOrigin& origin, const std::string& path);
+void SaveLanelet2Osm(const VectorMap& map, const GeoOrigin& origin, const std::string& path,
+                     Lanelet2ExportStats* stats = nullptr);
 
 }  // namespace ipm_road_mapper
