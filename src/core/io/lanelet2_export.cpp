@@ -9,7 +9,6 @@
 #include <utility>
 #include <vector>
 
-#include "ipm_road_mapper/core/io/geojson_export.h"  // kLaneSampleSpacing_m
 #include "ipm_road_mapper/core/io/map_geodesy.h"
 #include "ipm_road_mapper/core/map/lanelet_pairing.h"
 #include "json_io.h"

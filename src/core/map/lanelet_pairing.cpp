@@ -150,6 +150,7 @@ std::vector<Neighbour> LeftNeighbours(const std::vector<std::vector<Eigen::Vecto
     });
     double best = std::numeric_limits<double>::infinity();
     for (const Nearest& n : nearest) {
+      if (n.dist > kMaxLaneWidthM) continue;  // a cell shared by the hash, not a neighbour
       const Eigen::Vector2d& v = n.offset;
       const Eigen::Vector2d& dj = n.direction;
       if (d.dot(dj) < min_cos) continue;              // not parallel, or the other way

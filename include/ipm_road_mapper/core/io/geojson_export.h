@@ -27,15 +27,13 @@
 #include <optional>
 #include <string>
 
+#include "ipm_road_mapper/core/io/map_geodesy.h"  // kLaneSampleSpacing_m
 #include "ipm_road_mapper/core/io/yaml_options.h"
 #include "ipm_road_mapper/core/map/vector_map.h"
 
 namespace ipm_road_mapper {
 
 // GeoOrigin (where the map frame's origin is on the Earth) is declared in vector_map.h.
-
-// Lane splines are sampled this often (arc length, m) for the LineStrings.
-constexpr double kLaneSampleSpacing_m = 0.5;
 
 // Values of the "coordinate_system" member/property.
 constexpr const char* kCoordinateSystemLocal = "local_metric_enu_m";

@@ -14,6 +14,9 @@
 
 namespace ipm_road_mapper {
 
+// Lane splines are sampled this often (arc length, m) in the exports' line strings.
+constexpr double kLaneSampleSpacing_m = 0.5;
+
 // A point on WGS84.
 struct Wgs84Point {
   double latitude_deg = 0.0;
