@@ -67,6 +67,17 @@ def print_tables(scenarios, results, table, fmt, real_absent=False):
         "false positives", "lane F1", "splines per matched GT line", "rot (deg)",
         "roll after (deg)", "trans (m)", "IPM grid (m)", "pose trans (m)", "pose yaw (deg)"], rows)
 
+    rows = []
+    for d in _drives(scenarios, results):
+        m = ours(d)
+        rows.append([d, "%s / %s" % (m.get("lanelet_map_total"), m.get("lanelet_gt_total")),
+                     fmt(m.get("lanelet_recall"), 2), fmt(m.get("lanelet_precision"), 2),
+                     fmt(m.get("lanelets_per_covered_gt_lanelet"), 2)])
+    table("Table 5b. Lanelets of the mapped lines (what the Lanelet2 export holds) against those of "
+          "the GT lines, by centerline length", [
+              "drive", "lanelets map / GT", "lanelet recall", "lanelet precision",
+              "lanelets per covered GT lanelet"], rows)
+
     def seeds(key, digits=3):
         """Per scenario: seeds 1-3 of `key`, and their mean (a single seed's figure moves by
         about 0.01 m with the noise drawn alone: docs/benchmark.md, tenth wave)."""

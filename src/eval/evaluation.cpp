@@ -215,6 +215,7 @@ Metrics EvaluateMap(const VectorMap& map, const GroundTruth& gt, const Evaluatio
   metrics.options = options;
   metrics.markings = EvaluateMarkings(map, gt, options);
   metrics.lanes = EvaluateLanes(map, gt, options);
+  metrics.lanelets = EvaluateLanelets(map, gt, options);
   metrics.extrinsic = EvaluateExtrinsic(map, gt, options);
   metrics.poses = EvaluatePoses(map, gt, options);
   metrics.storage = EvaluateStorage(map, options);

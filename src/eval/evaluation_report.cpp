@@ -80,6 +80,16 @@ void AddMarkings(const MarkingMetrics& m, nlohmann::json* j) {
   (*j)["gt_markings"] = gt_markings;
 }
 
+void AddLanelets(const LaneletMetrics& m, nlohmann::json* j) {
+  (*j)["lanelet_gt_total"] = m.gt_total;
+  (*j)["lanelet_map_total"] = m.map_total;
+  (*j)["lanelet_gt_length_m"] = Number(m.gt_length_m);
+  (*j)["lanelet_map_length_m"] = Number(m.map_length_m);
+  (*j)["lanelet_recall"] = Number(m.recall);
+  (*j)["lanelet_precision"] = Number(m.precision);
+  (*j)["lanelets_per_covered_gt_lanelet"] = Number(m.lanelets_per_covered_gt_lanelet);
+}
+
 void AddLanes(const LaneMetrics& m, nlohmann::json* j) {
   AddSummary("lane_ape", "_m", m.error_m, j);
   (*j)["lane_ape_xy_mean_m"] = Number(m.error_xy_mean_m);
@@ -191,6 +201,7 @@ nlohmann::json MetricsToJson(const Metrics& metrics) {
   nlohmann::json j = nlohmann::json::object();
   AddMarkings(metrics.markings, &j);
   AddLanes(metrics.lanes, &j);
+  AddLanelets(metrics.lanelets, &j);
   AddExtrinsic(metrics.extrinsic, &j);
   AddPoses(metrics.poses, &j);
   const StorageMetrics& s = metrics.storage;

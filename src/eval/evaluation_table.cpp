@@ -95,6 +95,12 @@ void AddLaneRows(const Metrics& metrics, Table* t) {
   t->Row("recall (GT lanes covered / all)",
          Fixed(l.recall, 3) + " (" + Count(l.gt_matched, l.gt_total) + ")", "", "");
   t->Row("splines per covered GT lane", Fixed(l.splines_per_matched_gt_lane, 2), "", "");
+  const LaneletMetrics& ll = metrics.lanelets;
+  t->Row("lanelets (map / GT, lanelet_pairing.h)",
+         std::to_string(ll.map_total) + " / " + std::to_string(ll.gt_total), "", "");
+  t->Row("lanelet recall / precision (centerline length)",
+         Fixed(ll.recall, 3) + " / " + Fixed(ll.precision, 3), "", "");
+  t->Row("lanelets per covered GT lanelet", Fixed(ll.lanelets_per_covered_gt_lanelet, 2), "", "");
 }
 
 void AddExtrinsicRows(const Metrics& metrics, Table* t) {

@@ -140,6 +140,25 @@ struct LaneMetrics {
   std::vector<GroundTruthLaneResult> gt_lanes;
 };
 
+// Lanelets: what a lane-level map (the Lanelet2 export) gets from the mapped lines. The
+// lanelets of the map's lines and those of the GT lines are found by the same rule
+// (core/map/lanelet_pairing.h) and compared by their centerlines, sampled every
+// kLaneletSampleSpacingM: a sample of one is on the other where a centerline sample of the
+// other, running the same way (within 30 deg), lies within lane_match_distance_m.
+constexpr double kLaneletSampleSpacingM = 1.0;
+struct LaneletMetrics {
+  int gt_total = 0;
+  int map_total = 0;
+  double gt_length_m = 0.0;     // of the GT lanelets' centerlines
+  double map_length_m = 0.0;    // of the map lanelets' centerlines
+  double recall = kNoValue;     // share of the GT centerlines' length on a map lanelet
+  double precision = kNoValue;  // share of the map centerlines' length on a GT lanelet
+  // Over the GT lanelets covered for at least lane_match_fraction of their length: the mean
+  // number of map lanelets lying on each for at least lane_cover_min_length_m. 1 is ideal; a
+  // lane whose lines are broken into pieces is several lanelets.
+  double lanelets_per_covered_gt_lanelet = kNoValue;
+};
+
 // Refined and initial extrinsic against the truth, and the IPM error they cause.
 struct ExtrinsicMetrics {
   double rot_err_deg = kNoValue;
@@ -201,6 +220,7 @@ struct StorageMetrics {
 struct Metrics {
   MarkingMetrics markings;
   LaneMetrics lanes;
+  LaneletMetrics lanelets;
   ExtrinsicMetrics extrinsic;
   PoseMetrics poses;
   StorageMetrics storage;
@@ -215,6 +235,10 @@ MarkingMetrics EvaluateMarkings(const VectorMap& map, const GroundTruth& gt,
 // Samples the mapped splines and measures them against the GT lane polylines.
 LaneMetrics EvaluateLanes(const VectorMap& map, const GroundTruth& gt,
                           const EvaluationOptions& options);
+
+// The map's lanelets against the GT's (LaneletMetrics).
+LaneletMetrics EvaluateLanelets(const VectorMap& map, const GroundTruth& gt,
+                                const EvaluationOptions& options);
 
 // Compares map.T_base_cam and map.T_base_cam_initial with gt.T_base_cam_true.
 ExtrinsicMetrics EvaluateExtrinsic(const VectorMap& map, const GroundTruth& gt,
