@@ -35,10 +35,10 @@ constexpr double kMaxLaneWidthM = 5.0;
 constexpr double kMaxNeighbourAngleRad = 20.0 * 3.14159265358979323846 / 180.0;
 constexpr double kMinLaneletLengthM = 10.0;
 // Cuts closer than this along a line are one cut, and a line is not cut closer than
-// kEndSnapM to its ends (a lane that ends a few metres before its neighbour ends with it):
-// no lanelet is a sliver.
+// kEndSnapM to its ends (a line first seen a few metres later than its neighbour starts its
+// lane with it): no lanelet is a sliver.
 constexpr double kMergeCutsM = 2.0;
-constexpr double kEndSnapM = 0.5 * kMinLaneletLengthM;
+constexpr double kEndSnapM = kMinLaneletLengthM;
 
 // One lanelet: the piece `right_piece` of line `right_line` and the piece `left_piece` of
 // line `left_line` (pieces numbered along the line, between its cuts).
