@@ -120,7 +120,7 @@ class SampleGrid {
   }
 
  private:
-  std::int64_t Cell(double v) const { return static_cast<std::int64_t>(std::floor(v / cell_m_)); }
+  std::int64_t Cell(double v) const { return GridCell(v, cell_m_); }
   static std::int64_t Key(std::int64_t x, std::int64_t y) {
     return x * 73856093LL ^ y * 19349663LL;
   }

@@ -117,6 +117,19 @@ TEST(LaneletPairing, LinesAreOrientedAlongTheDrive) {
   EXPECT_EQ(LaneOrientedAlongDrive(along, {}).front(), along.front());  // no trajectory
 }
 
+TEST(LaneletPairing, AbsurdLinesAreNoLanesAndCostNothing) {
+  // A two-point "line" 1e9 m long beside a real one, a line at 1e300 m and a point line: no
+  // lanelet, no hang, no overflow.
+  const std::vector<Eigen::Vector3d> huge = {{0, 3.5, 0}, {1e9, 3.5, 0}};
+  const std::vector<Eigen::Vector3d> far = {{1e300, 0, 0}, {1e300, 10, 0}};
+  const std::vector<Eigen::Vector3d> point = {{5, 5, 0}, {5, 5, 0}};
+  const LaneletLayout layout = PairLanelets({Straight(0.0, 0, 100), huge, far, point});
+  EXPECT_TRUE(layout.lanelets.empty());
+  EXPECT_EQ(GridCell(1e300, 5.0), GridCell(2e12, 5.0));
+  EXPECT_EQ(GridCell(std::nan(""), 5.0), 0);
+  EXPECT_EQ(GridCell(-7.0, 5.0), -2);
+}
+
 TEST(LaneletPairing, ArcLengthsAndPoints) {
   const std::vector<Eigen::Vector3d> line = {{0, 0, 0}, {3, 4, 1}, {3, 10, 1}};
   const std::vector<double> arc = ArcLengths(line);

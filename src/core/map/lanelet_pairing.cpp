@@ -40,6 +40,7 @@ class SegmentGrid {
     for (std::size_t l = 0; l < lines.size(); ++l) {
       for (std::size_t k = 0; k + 1 < lines[l].size(); ++k) {
         const Eigen::Vector2d a = lines[l][k].head<2>(), b = lines[l][k + 1].head<2>();
+        if (!((b - a).norm() <= kMaxIndexedSegmentM)) continue;
         const auto [x0, y0] = Cell(a.cwiseMin(b));
         const auto [x1, y1] = Cell(a.cwiseMax(b));
         for (std::int64_t x = x0; x <= x1; ++x) {
@@ -64,8 +65,7 @@ class SegmentGrid {
 
  private:
   static std::pair<std::int64_t, std::int64_t> Cell(const Eigen::Vector2d& p) {
-    return {static_cast<std::int64_t>(std::floor(p.x() / kMaxLaneWidthM)),
-            static_cast<std::int64_t>(std::floor(p.y() / kMaxLaneWidthM))};
+    return {GridCell(p.x(), kMaxLaneWidthM), GridCell(p.y(), kMaxLaneWidthM)};
   }
   static std::int64_t Key(std::int64_t x, std::int64_t y) {
     return x * 73856093LL ^ y * 19349663LL;
@@ -171,6 +171,12 @@ std::vector<Neighbour> LeftNeighbours(const std::vector<std::vector<Eigen::Vecto
 }
 
 }  // namespace
+
+std::int64_t GridCell(double v, double cell_m) {
+  const double limit = 1e12;
+  const double clamped = std::isfinite(v) ? std::clamp(v, -limit, limit) : 0.0;
+  return static_cast<std::int64_t>(std::floor(clamped / cell_m));
+}
 
 std::vector<double> ArcLengths(const std::vector<Eigen::Vector3d>& polyline) {
   std::vector<double> arc(polyline.size(), 0.0);
