@@ -1,14 +1,13 @@
 // Lanelet evaluation (LaneletMetrics in evaluation.h): the lanelets of the map's lines against
 // those of the GT lines, both found by core/map/lanelet_pairing.h, compared by centerlines.
 #include <cmath>
-#include <cstdint>
 #include <map>
 #include <set>
-#include <unordered_map>
 #include <vector>
 
 #include "ipm_road_mapper/core/io/map_geodesy.h"
 #include "ipm_road_mapper/core/map/lanelet_pairing.h"
+#include "ipm_road_mapper/core/mapper/frame_index.h"
 #include "ipm_road_mapper/eval/evaluation.h"
 
 namespace ipm_road_mapper {
@@ -59,16 +58,12 @@ std::vector<CenterSample> Centerlines(const std::vector<std::vector<Eigen::Vecto
   *count = layout.lanelets.size();
   std::vector<std::vector<double>> arcs;
   for (const auto& line : lines) arcs.push_back(ArcLengths(line));
-  auto piece_range = [&](std::size_t line, std::size_t piece) {
-    const std::vector<double>& cuts = layout.cuts[line];
-    return std::make_pair(piece == 0 ? 0.0 : cuts[piece - 1],
-                          piece < cuts.size() ? cuts[piece] : arcs[line].back());
-  };
   std::vector<CenterSample> samples;
   for (std::size_t k = 0; k < layout.lanelets.size(); ++k) {
     const LaneletBounds& b = layout.lanelets[k];
-    const auto [r0, r1] = piece_range(b.right_line, b.right_piece);
-    const auto [l0, l1] = piece_range(b.left_line, b.left_piece);
+    const auto [r0, r1] =
+        PieceRange(layout, b.right_line, b.right_piece, arcs[b.right_line].back());
+    const auto [l0, l1] = PieceRange(layout, b.left_line, b.left_piece, arcs[b.left_line].back());
     const int n = std::max(
         1, static_cast<int>(std::ceil(std::max(r1 - r0, l1 - l0) / kLaneletSampleSpacingM)));
     std::vector<Eigen::Vector2d> points;
@@ -90,44 +85,24 @@ std::vector<CenterSample> Centerlines(const std::vector<std::vector<Eigen::Vecto
   return samples;
 }
 
-// Samples in a uniform grid of cells `cell_m` wide, for the ones near a point.
-class SampleGrid {
- public:
-  SampleGrid(const std::vector<CenterSample>& samples, double cell_m)
-      : samples_(samples), cell_m_(cell_m) {
-    for (std::size_t i = 0; i < samples.size(); ++i) {
-      cells_[Key(Cell(samples[i].p.x()), Cell(samples[i].p.y()))].push_back(i);
-    }
+// The samples of `samples` in a spatial index (the one the mapper keeps of its frames).
+FrameIndex IndexOf(const std::vector<CenterSample>& samples, double cell_m) {
+  FrameIndex index(cell_m);
+  for (std::size_t i = 0; i < samples.size(); ++i) {
+    index.Set(i, Eigen::Vector3d(samples[i].p.x(), samples[i].p.y(), 0.0));
   }
+  return index;
+}
 
-  // The samples within `radius_m` (<= cell_m) of p running within 30 deg of `direction`.
-  template <typename Visit>
-  void Near(const Eigen::Vector2d& p, const Eigen::Vector2d& direction, double radius_m,
-            Visit visit) const {
-    const std::int64_t cx = Cell(p.x()), cy = Cell(p.y());
-    for (std::int64_t x = cx - 1; x <= cx + 1; ++x) {
-      for (std::int64_t y = cy - 1; y <= cy + 1; ++y) {
-        const auto it = cells_.find(Key(x, y));
-        if (it == cells_.end()) continue;
-        for (std::size_t i : it->second) {
-          const CenterSample& s = samples_[i];
-          if ((s.p - p).norm() <= radius_m && s.direction.dot(direction) >= kMinDirectionCos) {
-            visit(s);
-          }
-        }
-      }
-    }
+// The samples of `samples` (indexed by `index`) within radius_m of `s` running within 30 deg
+// of it.
+template <typename Visit>
+void ForEachOn(const std::vector<CenterSample>& samples, const FrameIndex& index,
+               const CenterSample& s, double radius_m, Visit visit) {
+  for (std::size_t i : index.Within(Eigen::Vector3d(s.p.x(), s.p.y(), 0.0), radius_m)) {
+    if (samples[i].direction.dot(s.direction) >= kMinDirectionCos) visit(samples[i]);
   }
-
- private:
-  std::int64_t Cell(double v) const { return GridCell(v, cell_m_); }
-  static std::int64_t Key(std::int64_t x, std::int64_t y) {
-    return x * 73856093LL ^ y * 19349663LL;
-  }
-  const std::vector<CenterSample>& samples_;
-  double cell_m_;
-  std::unordered_map<std::int64_t, std::vector<std::size_t>> cells_;
-};
+}
 
 }  // namespace
 
@@ -160,14 +135,15 @@ LaneletMetrics EvaluateLanelets(const VectorMap& map, const GroundTruth& gt,
   const double cell = std::max(radius, 1e-3);
 
   // Recall, and per GT lanelet its covered samples and the map lanelets lying on it.
-  const SampleGrid map_grid(map_samples, cell);
+  const FrameIndex map_index = IndexOf(map_samples, cell);
   std::vector<std::size_t> covered(gt_count, 0), total(gt_count, 0);
   std::vector<std::map<std::size_t, std::size_t>> on(gt_count);  // map lanelet -> samples
   std::size_t gt_on = 0;
   for (const CenterSample& g : gt_samples) {
     ++total[g.lanelet];
     std::set<std::size_t> here;
-    map_grid.Near(g.p, g.direction, radius, [&](const CenterSample& m) { here.insert(m.lanelet); });
+    ForEachOn(map_samples, map_index, g, radius,
+              [&](const CenterSample& m) { here.insert(m.lanelet); });
     if (here.empty()) continue;
     ++gt_on;
     ++covered[g.lanelet];
@@ -177,11 +153,11 @@ LaneletMetrics EvaluateLanelets(const VectorMap& map, const GroundTruth& gt,
     metrics.recall = static_cast<double>(gt_on) / static_cast<double>(gt_samples.size());
   }
   // Precision.
-  const SampleGrid gt_grid(gt_samples, cell);
+  const FrameIndex gt_index = IndexOf(gt_samples, cell);
   std::size_t map_on = 0;
   for (const CenterSample& m : map_samples) {
     bool near = false;
-    gt_grid.Near(m.p, m.direction, radius, [&](const CenterSample&) { near = true; });
+    ForEachOn(gt_samples, gt_index, m, radius, [&](const CenterSample&) { near = true; });
     if (near) ++map_on;
   }
   if (!map_samples.empty()) {

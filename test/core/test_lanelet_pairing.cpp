@@ -7,6 +7,7 @@
 #include <cmath>
 #include <vector>
 
+#include "ipm_road_mapper/core/geometry/grid_cell.h"
 #include "ipm_road_mapper/core/map/lanelet_pairing.h"
 
 namespace ipm_road_mapper {

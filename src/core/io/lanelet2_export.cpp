@@ -162,30 +162,18 @@ void WriteMarking(const MapMarking& m, OsmWriter* osm) {
   osm->Way(nodes, tags);
 }
 
-// The middle of a piece of a line (between its cuts).
-Eigen::Vector3d PieceMiddle(const std::vector<Eigen::Vector3d>& line,
-                            const std::vector<double>& cuts, std::size_t piece) {
-  const std::vector<double> arc = ArcLengths(line);
-  const double from = piece == 0 ? 0.0 : cuts[piece - 1];
-  const double to = piece < cuts.size() ? cuts[piece] : arc.back();
-  return PointAtArcLength(line, arc, 0.5 * (from + to));
-}
-
-// Whether the drive went along the lane (its pose nearest to the lane's middle lies between
-// the bounds): its direction is known, one way. Other lanes (across a center line, say) may
-// carry traffic either way as far as the drive can tell.
-bool Driven(const std::vector<Eigen::Vector3d>& left, const std::vector<double>& left_cuts,
-            std::size_t left_piece, const std::vector<Eigen::Vector3d>& right,
-            const std::vector<double>& right_cuts, std::size_t right_piece,
+// Whether the drive went along the lane whose bounds' middles are `left` and `right` (its
+// pose nearest to the lane's middle lies between them): its direction is known, one way.
+// Other lanes (across a center line, say) may carry traffic either way as far as the drive
+// can tell.
+bool Driven(const Eigen::Vector2d& left, const Eigen::Vector2d& right,
             const std::vector<StampedPose>& trajectory) {
-  const Eigen::Vector2d l = PieceMiddle(left, left_cuts, left_piece).head<2>();
-  const Eigen::Vector2d r = PieceMiddle(right, right_cuts, right_piece).head<2>();
-  const Eigen::Vector2d middle = 0.5 * (l + r);
+  const Eigen::Vector2d middle = 0.5 * (left + right);
   double nearest = std::numeric_limits<double>::infinity();
   for (const StampedPose& pose : trajectory) {
     nearest = std::min(nearest, (pose.T_map_base.translation().head<2>() - middle).norm());
   }
-  return nearest <= 0.5 * (l - r).norm();
+  return nearest <= 0.5 * (left - right).norm();
 }
 
 }  // namespace
@@ -203,11 +191,13 @@ std::string VectorMapToLanelet2Osm(const VectorMap& map, const GeoOrigin& origin
     lines.push_back(LaneOrientedAlongDrive(std::move(polyline), map.trajectory));
   }
   const LaneletLayout layout = PairLanelets(lines);
+  std::vector<std::vector<double>> arcs;
+  for (const auto& line : lines) arcs.push_back(ArcLengths(line));
   // Each line's pieces: nodes at its samples and cuts, the cut nodes shared by the pieces
   // on both sides of them.
   std::vector<std::vector<std::uint64_t>> piece_ways(lines.size());
   for (std::size_t i = 0; i < lines.size(); ++i) {
-    const std::vector<double> arc = ArcLengths(lines[i]);
+    const std::vector<double>& arc = arcs[i];
     const std::vector<double>& cuts = layout.cuts[i];
     Tags tags = {{"type", "line_thin"}};
     if (lanes[i]->style == "solid" || lanes[i]->style == "dashed") {
@@ -237,9 +227,12 @@ std::string VectorMapToLanelet2Osm(const VectorMap& map, const GeoOrigin& origin
     piece_ways[i].push_back(osm.Way(piece, tags));
   }
   for (const LaneletBounds& b : layout.lanelets) {
-    const bool driven =
-        Driven(lines[b.left_line], layout.cuts[b.left_line], b.left_piece, lines[b.right_line],
-               layout.cuts[b.right_line], b.right_piece, map.trajectory);
+    auto piece_middle = [&](std::size_t line, std::size_t piece) {
+      const auto [from, to] = PieceRange(layout, line, piece, arcs[line].back());
+      return PointAtArcLength(lines[line], arcs[line], 0.5 * (from + to)).head<2>().eval();
+    };
+    const bool driven = Driven(piece_middle(b.left_line, b.left_piece),
+                               piece_middle(b.right_line, b.right_piece), map.trajectory);
     osm.Lanelet(piece_ways[b.left_line][b.left_piece], piece_ways[b.right_line][b.right_piece],
                 {{"type", "lanelet"},
                  {"subtype", "road"},

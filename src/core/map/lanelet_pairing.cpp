@@ -6,6 +6,8 @@
 #include <limits>
 #include <unordered_map>
 
+#include "ipm_road_mapper/core/geometry/grid_cell.h"
+
 namespace ipm_road_mapper {
 namespace {
 
@@ -172,10 +174,10 @@ std::vector<Neighbour> LeftNeighbours(const std::vector<std::vector<Eigen::Vecto
 
 }  // namespace
 
-std::int64_t GridCell(double v, double cell_m) {
-  const double limit = 1e12;
-  const double clamped = std::isfinite(v) ? std::clamp(v, -limit, limit) : 0.0;
-  return static_cast<std::int64_t>(std::floor(clamped / cell_m));
+std::pair<double, double> PieceRange(const LaneletLayout& layout, std::size_t line,
+                                     std::size_t piece, double length_m) {
+  const std::vector<double>& cuts = layout.cuts[line];
+  return {piece == 0 ? 0.0 : cuts[piece - 1], piece < cuts.size() ? cuts[piece] : length_m};
 }
 
 std::vector<double> ArcLengths(const std::vector<Eigen::Vector3d>& polyline) {

@@ -5,15 +5,15 @@
 #include <limits>
 #include <stdexcept>
 
+#include "ipm_road_mapper/core/geometry/grid_cell.h"
+
 namespace ipm_road_mapper {
 
 FrameIndex::FrameIndex(double cell_size_m) : cell_size_m_(cell_size_m) {
   if (!(cell_size_m > 0.0)) throw std::invalid_argument("FrameIndex: cell size must be > 0");
 }
 
-std::int64_t FrameIndex::Cell(double v) const {
-  return static_cast<std::int64_t>(std::floor(v / cell_size_m_));
-}
+std::int64_t FrameIndex::Cell(double v) const { return GridCell(v, cell_size_m_); }
 
 FrameIndex::Key FrameIndex::KeyOf(std::int64_t ix, std::int64_t iy) {
   // Cells within +-2^31 of the origin: that many cells of a meter or more cover any drive.

@@ -25,6 +25,7 @@
 #include <Eigen/Core>
 #include <cstddef>
 #include <cstdint>
+#include <utility>
 #include <vector>
 
 #include "ipm_road_mapper/core/geometry/rigid_transform.h"
@@ -65,13 +66,14 @@ std::vector<Eigen::Vector3d> LaneOrientedAlongDrive(std::vector<Eigen::Vector3d>
 // The lanelets between `lines` (oriented polylines, map frame; see the file comment).
 LaneletLayout PairLanelets(const std::vector<std::vector<Eigen::Vector3d>>& lines);
 
-// The index of the grid cell `cell_m` wide that holds coordinate v (m), for the spatial grids
-// of the pairing and its evaluation; coordinates beyond +-1e12 m share the outermost cells.
-std::int64_t GridCell(double v, double cell_m);
-
 // Segments longer than this are not indexed: no lane line has one, and a hostile map's
 // kilometre-long segment would fill the grid.
 constexpr double kMaxIndexedSegmentM = 1000.0;
+
+// The arc-length range [from, to] of piece `piece` of line `line` (between its cuts, or the
+// line's ends: `length_m`).
+std::pair<double, double> PieceRange(const LaneletLayout& layout, std::size_t line,
+                                     std::size_t piece, double length_m);
 
 // Arc length of each sample of a polyline (x-y), starting at 0.
 std::vector<double> ArcLengths(const std::vector<Eigen::Vector3d>& polyline);
