@@ -219,6 +219,7 @@ Metrics EvaluateMap(const VectorMap& map, const GroundTruth& gt, const Evaluatio
   metrics.extrinsic = EvaluateExtrinsic(map, gt, options);
   metrics.poses = EvaluatePoses(map, gt, options);
   metrics.storage = EvaluateStorage(map, options);
+  metrics.ceiling = EvaluateViewCeiling(gt, options);
   return metrics;
 }
 

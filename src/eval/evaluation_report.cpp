@@ -130,6 +130,30 @@ void AddLanes(const LaneMetrics& m, nlohmann::json* j) {
   (*j)["gt_lanes"] = gt_lanes;
 }
 
+void AddCeiling(const ViewCeilingMetrics& m, nlohmann::json* j) {
+  (*j)["ceiling_view_range_m"] = m.view_range_m;
+  (*j)["ceiling_lane_recall"] = Number(m.lane_recall);
+  (*j)["ceiling_lane_f1"] = Number(m.lane_f1);
+  (*j)["ceiling_lanes_reachable"] = m.lanes_reachable;
+  (*j)["ceiling_marking_recall"] = Number(m.marking_recall);
+  (*j)["ceiling_markings_reachable"] = m.markings_reachable;
+  nlohmann::json lanes = nlohmann::json::array();
+  for (const ViewCeilingLane& r : m.lanes) {
+    lanes.push_back(
+        {{"gt_id", r.gt_id}, {"in_view_fraction", r.in_view_fraction}, {"reachable", r.reachable}});
+  }
+  (*j)["ceiling_lanes"] = lanes;
+  nlohmann::json markings = nlohmann::json::array();
+  for (const ViewCeilingMarking& r : m.markings) {
+    markings.push_back({{"gt_id", r.gt_id},
+                        {"visible_frames", r.visible_frames},
+                        {"in_view_fraction", r.in_view_fraction},
+                        {"in_view_center_offset_m", Number(r.in_view_center_offset_m)},
+                        {"reachable", r.reachable}});
+  }
+  (*j)["ceiling_markings"] = markings;
+}
+
 void AddExtrinsic(const ExtrinsicMetrics& m, nlohmann::json* j) {
   (*j)["extrinsic_rot_err_deg"] = Number(m.rot_err_deg);
   (*j)["extrinsic_trans_err_m"] = Number(m.trans_err_m);
@@ -192,7 +216,9 @@ nlohmann::json OptionsToJson(const EvaluationOptions& o) {
           {"pose_stamp_tolerance_s", o.pose_stamp_tolerance_s},
           {"ipm_grid_step_px", o.ipm_grid_step_px},
           {"ipm_grid_min_ahead_m", o.ipm_grid_min_ahead_m},
-          {"ipm_grid_max_ahead_m", o.ipm_grid_max_ahead_m}};
+          {"ipm_grid_max_ahead_m", o.ipm_grid_max_ahead_m},
+          {"view_range_m", o.view_range_m},
+          {"view_marking_sample_spacing_m", o.view_marking_sample_spacing_m}};
 }
 
 }  // namespace
@@ -202,6 +228,7 @@ nlohmann::json MetricsToJson(const Metrics& metrics) {
   AddMarkings(metrics.markings, &j);
   AddLanes(metrics.lanes, &j);
   AddLanelets(metrics.lanelets, &j);
+  AddCeiling(metrics.ceiling, &j);
   AddExtrinsic(metrics.extrinsic, &j);
   AddPoses(metrics.poses, &j);
   const StorageMetrics& s = metrics.storage;

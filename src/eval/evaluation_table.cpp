@@ -103,6 +103,18 @@ void AddLaneRows(const Metrics& metrics, Table* t) {
   t->Row("lanelets per covered GT lanelet", Fixed(ll.lanelets_per_covered_gt_lanelet, 2), "", "");
 }
 
+// What a map of exactly the road in view would score (view_ceiling.h), beside the map's.
+void AddCeilingRows(const Metrics& metrics, Table* t) {
+  const ViewCeilingMetrics& c = metrics.ceiling;
+  t->Section("The view's ceiling (road in view within " + Fixed(c.view_range_m, 0) + " m)", "map",
+             "ceiling");
+  t->Row("marking recall", Count(metrics.markings.matched_visible, metrics.markings.gt_visible),
+         Count(c.markings_reachable, c.markings_visible), "");
+  t->Row("lane recall", Count(metrics.lanes.gt_matched, metrics.lanes.gt_total),
+         Count(c.lanes_reachable, c.lanes_total), "");
+  t->Row("lane F1 (ceiling: precision 1)", Fixed(metrics.lanes.f1, 3), Fixed(c.lane_f1, 3), "");
+}
+
 void AddExtrinsicRows(const Metrics& metrics, Table* t) {
   const ExtrinsicMetrics& e = metrics.extrinsic;
   t->Section("Extrinsic T_base_cam", "refined", "initial");
@@ -168,6 +180,7 @@ std::string FormatMetricsTable(const Metrics& metrics) {
   Table table;
   AddMarkingRows(metrics, &table);
   AddLaneRows(metrics, &table);
+  AddCeilingRows(metrics, &table);
   AddExtrinsicRows(metrics, &table);
   AddPoseRows(metrics, &table);
   AddStorageRows(metrics, &table);

@@ -2,7 +2,7 @@
 // table and writes the metrics JSON (keys in docs/file_formats.md).
 //
 //   rosrun ipm_road_mapper evaluate_map --map map.json --ground-truth ground_truth.json
-//       [--json metrics.json] [--map-bytes N]
+//       [--json metrics.json] [--map-bytes N] [--view-range-m M]
 //
 // Exit codes: 0 success (or --help), 2 bad input (bad command line, missing or malformed
 // file; one line on stderr), 1 any other failure (e.g. the metrics file cannot be written).
@@ -28,6 +28,8 @@ struct Arguments {
   std::string ground_truth_path;
   std::string json_path;        // empty: no JSON file
   std::int64_t map_bytes = -1;  // < 0: the map file's size
+  std::int64_t view_range_m =
+      static_cast<std::int64_t>(ipm_road_mapper::EvaluationOptions().view_range_m);
 };
 
 // Parses the command line (pipeline/command_line.h): the exit code when the tool stops
@@ -42,7 +44,11 @@ std::optional<int> ParseArguments(int argc, char** argv, Arguments* args) {
                 "the drive's ground truth (generate_drive)")
       .Optional("json", "<metrics.json>", &args->json_path, "none", "metrics JSON to write")
       .Integer("map-bytes", "<n>", &args->map_bytes, 0, std::numeric_limits<std::int64_t>::max(),
-               false, "the size of the --map file", "map size for the storage metrics");
+               false, "the size of the --map file", "map size for the storage metrics")
+      .Integer("view-range-m", "<m>", &args->view_range_m, 1, 100000, false,
+               std::to_string(args->view_range_m) + " (config/mapper.yaml's ipm.max_range_m)",
+               "ground farther from base_link is out of view for the view's ceiling "
+               "(eval/view_ceiling.h)");
   return line.ParseOrExitCode(argc, argv);
 }
 
@@ -57,6 +63,7 @@ int Run(int argc, char** argv) {
   options.map_bytes = args.map_bytes >= 0
                           ? args.map_bytes
                           : static_cast<std::int64_t>(std::filesystem::file_size(args.map_path));
+  options.view_range_m = static_cast<double>(args.view_range_m);
   const Metrics metrics = EvaluateMap(map, gt, options);
   std::cout << "map: " << args.map_path << "\nground truth: " << args.ground_truth_path
             << " (scenario '" << gt.scenario << "', seed " << gt.seed << ")\n"

@@ -12,6 +12,7 @@
 
 #include "ipm_road_mapper/core/io/ground_truth.h"
 #include "ipm_road_mapper/core/map/vector_map.h"
+#include "ipm_road_mapper/eval/view_ceiling.h"
 
 namespace ipm_road_mapper {
 
@@ -31,6 +32,11 @@ struct EvaluationOptions {
   // Most mapped-spline samples over all lanes (100 km at 0.1 m, about 1.5 s of sampling and
   // queries); a map needing more is refused with a MapFormatError before any sampling.
   double max_lane_samples = 1e6;
+  // The view's ceiling (view_ceiling.h): ground farther than this from base_link is out of
+  // view (config/mapper.yaml's ipm.max_range_m), and a marking's in-view part is sampled on
+  // a grid this fine.
+  double view_range_m = 40.0;
+  double view_marking_sample_spacing_m = 0.1;
 };
 
 // Value of a metric that cannot be computed (no data); written as null in the JSON.
@@ -224,6 +230,7 @@ struct Metrics {
   ExtrinsicMetrics extrinsic;
   PoseMetrics poses;
   StorageMetrics storage;
+  ViewCeilingMetrics ceiling;
   EvaluationOptions options;
 };
 
