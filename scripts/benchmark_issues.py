@@ -87,12 +87,14 @@ def print_tables(scenarios, results, table, fmt, real_absent=False):
                      "%s / %s" % (m.get("ceiling_markings_reachable"), m.get("marking_gt_visible")),
                      "%s / %s" % (m.get("lane_gt_matched"), m.get("lane_gt_total")),
                      "%s / %s" % (m.get("ceiling_lanes_reachable"), m.get("lane_gt_total")),
-                     "%s / %s" % (fmt(m.get("lane_f1"), 2), fmt(m.get("ceiling_lane_f1"), 2))])
+                     "%s / %s" % (fmt(m.get("lane_f1"), 2), fmt(m.get("ceiling_lane_f1"), 2)),
+                     "%s / %s, %s" % (m.get("seen_part_matched"), m.get("seen_part_gt"),
+                                      fmt(m.get("seen_part_ape_mean_m")))])
     table("Table 5c. The view's ceiling: what a map of exactly the road in view (within "
           "ipm.max_range_m of a true pose, through the true extrinsic) would score; GT only, "
-          "eval/view_ceiling.h", [
+          "eval/view_ceiling.h. Last column: map markings on the seen part of their marking", [
               "drive", "markings matched / GT", "reachable / GT", "GT lines matched / all",
-              "reachable / all", "lane F1 / ceiling"], rows)
+              "reachable / all", "lane F1 / ceiling", "on seen part / seen, APE (m)"], rows)
 
     def ceiling(m, reachable_key, total_key):
         """' (view ceiling r / n)' when the drive's view caps the figure below its total."""

@@ -220,6 +220,7 @@ Metrics EvaluateMap(const VectorMap& map, const GroundTruth& gt, const Evaluatio
   metrics.poses = EvaluatePoses(map, gt, options);
   metrics.storage = EvaluateStorage(map, options);
   metrics.ceiling = EvaluateViewCeiling(gt, options);
+  metrics.seen_parts = EvaluateSeenParts(map, gt, metrics.ceiling, options);
   return metrics;
 }
 

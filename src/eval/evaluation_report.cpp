@@ -148,10 +148,27 @@ void AddCeiling(const ViewCeilingMetrics& m, nlohmann::json* j) {
     markings.push_back({{"gt_id", r.gt_id},
                         {"visible_frames", r.visible_frames},
                         {"in_view_fraction", r.in_view_fraction},
+                        {"in_view_center_map", Vector(r.in_view_center_map)},
                         {"in_view_center_offset_m", Number(r.in_view_center_offset_m)},
                         {"reachable", r.reachable}});
   }
   (*j)["ceiling_markings"] = markings;
+}
+
+void AddSeenParts(const SeenPartMetrics& m, nlohmann::json* j) {
+  (*j)["seen_part_gt"] = m.gt_seen;
+  (*j)["seen_part_matched"] = m.matched;
+  (*j)["seen_part_recall"] = Number(m.recall);
+  (*j)["seen_part_ape_mean_m"] = Number(m.center_error_mean_m);
+  (*j)["seen_part_ape_max_m"] = Number(m.center_error_max_m);
+  nlohmann::json markings = nlohmann::json::array();
+  for (const SeenPartMarking& r : m.markings) {
+    markings.push_back({{"gt_id", r.gt_id},
+                        {"matched", r.matched},
+                        {"map_id", r.matched ? nlohmann::json(r.map_id) : nullptr},
+                        {"center_err_m", Number(r.center_error_m)}});
+  }
+  (*j)["seen_part_markings"] = markings;
 }
 
 void AddExtrinsic(const ExtrinsicMetrics& m, nlohmann::json* j) {
@@ -229,6 +246,7 @@ nlohmann::json MetricsToJson(const Metrics& metrics) {
   AddLanes(metrics.lanes, &j);
   AddLanelets(metrics.lanelets, &j);
   AddCeiling(metrics.ceiling, &j);
+  AddSeenParts(metrics.seen_parts, &j);
   AddExtrinsic(metrics.extrinsic, &j);
   AddPoses(metrics.poses, &j);
   const StorageMetrics& s = metrics.storage;

@@ -113,6 +113,9 @@ void AddCeilingRows(const Metrics& metrics, Table* t) {
   t->Row("lane recall", Count(metrics.lanes.gt_matched, metrics.lanes.gt_total),
          Count(c.lanes_reachable, c.lanes_total), "");
   t->Row("lane F1 (ceiling: precision 1)", Fixed(metrics.lanes.f1, 3), Fixed(c.lane_f1, 3), "");
+  const SeenPartMetrics& p = metrics.seen_parts;
+  t->Row("markings on their seen part / seen", Count(p.matched, p.gt_seen), "", "");
+  t->Row("center APE to the seen part's center", Fixed(p.center_error_mean_m, 3), "", "m");
 }
 
 void AddExtrinsicRows(const Metrics& metrics, Table* t) {

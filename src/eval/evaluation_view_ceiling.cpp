@@ -2,6 +2,8 @@
 // frame of the drive saw, and what a map of exactly those parts would score.
 #include <algorithm>
 #include <cmath>
+#include <numeric>
+#include <tuple>
 
 #include "ipm_road_mapper/core/geometry/pinhole_camera.h"
 #include "ipm_road_mapper/core/mapper/frame_index.h"
@@ -104,6 +106,7 @@ ViewCeilingMarking MarkingCeiling(const GroundTruthMarking& marking, const Drive
   result.gt_id = marking.id;
   result.visible_frames = marking.visible_frames;
   result.in_view_center_offset_m = kNoValue;
+  result.in_view_center_map = Eigen::Vector3d::Constant(kNoValue);
   const std::array<Eigen::Vector3d, 4>& c = marking.corners_map;
   double radius_m = 0.0;
   for (const Eigen::Vector3d& corner : c) {
@@ -134,6 +137,7 @@ ViewCeilingMarking MarkingCeiling(const GroundTruthMarking& marking, const Drive
   result.in_view_fraction = static_cast<double>(seen) / (ns * nt);
   if (seen > 0) {
     const Eigen::Vector3d center = Bilinear(c, 0.5 * (s_min + s_max), 0.5 * (t_min + t_max));
+    result.in_view_center_map = center;
     result.in_view_center_offset_m = (center - marking.center_map).norm();
     result.reachable =
         marking.visible_frames > 0 && result.in_view_center_offset_m <= options.marking_gate_m;
@@ -165,6 +169,49 @@ ViewCeilingMetrics EvaluateViewCeiling(const GroundTruth& gt, const EvaluationOp
   if (metrics.markings_visible > 0) {
     metrics.marking_recall =
         static_cast<double>(metrics.markings_reachable) / metrics.markings_visible;
+  }
+  return metrics;
+}
+
+SeenPartMetrics EvaluateSeenParts(const VectorMap& map, const GroundTruth& gt,
+                                  const ViewCeilingMetrics& ceiling,
+                                  const EvaluationOptions& options) {
+  SeenPartMetrics metrics;
+  metrics.recall = metrics.center_error_mean_m = metrics.center_error_max_m = kNoValue;
+  // (distance, map index, index into metrics.markings), nearest first.
+  std::vector<std::tuple<double, std::size_t, std::size_t>> pairs;
+  for (std::size_t j = 0; j < gt.markings.size() && j < ceiling.markings.size(); ++j) {
+    const ViewCeilingMarking& seen = ceiling.markings[j];
+    if (seen.visible_frames <= 0 || !seen.in_view_center_map.allFinite()) continue;
+    SeenPartMarking result;
+    result.gt_id = seen.gt_id;
+    result.center_error_m = kNoValue;
+    metrics.markings.push_back(result);
+    for (std::size_t i = 0; i < map.markings.size(); ++i) {
+      if (map.markings[i].class_id != gt.markings[j].class_id) continue;
+      const double d = (map.markings[i].Center() - seen.in_view_center_map).norm();
+      if (d <= options.marking_gate_m) pairs.emplace_back(d, i, metrics.markings.size() - 1);
+    }
+  }
+  std::sort(pairs.begin(), pairs.end());
+  std::vector<bool> map_used(map.markings.size(), false);
+  std::vector<double> errors;
+  for (const auto& [d, i, k] : pairs) {
+    SeenPartMarking& result = metrics.markings[k];
+    if (map_used[i] || result.matched) continue;
+    map_used[i] = true;
+    result.matched = true;
+    result.map_id = map.markings[i].id;
+    result.center_error_m = d;
+    errors.push_back(d);
+  }
+  metrics.gt_seen = static_cast<int>(metrics.markings.size());
+  metrics.matched = static_cast<int>(errors.size());
+  if (metrics.gt_seen > 0) metrics.recall = static_cast<double>(metrics.matched) / metrics.gt_seen;
+  if (!errors.empty()) {
+    metrics.center_error_mean_m =
+        std::accumulate(errors.begin(), errors.end(), 0.0) / static_cast<double>(errors.size());
+    metrics.center_error_max_m = *std::max_element(errors.begin(), errors.end());
   }
   return metrics;
 }

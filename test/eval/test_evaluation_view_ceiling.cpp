@@ -107,6 +107,52 @@ TEST(ViewCeiling, MarkingWiderThanTheViewIsUnreachable) {
   EXPECT_TRUE(centered.markings[0].reachable);
 }
 
+MapMarking MapRectangle(std::uint64_t id, double x0, double x1, double y0, double y1) {
+  MapMarking m;
+  m.id = id;
+  m.class_id = 10;
+  m.corners_map = {Eigen::Vector3d(x0, y0, 0.0), Eigen::Vector3d(x1, y0, 0.0),
+                   Eigen::Vector3d(x1, y1, 0.0), Eigen::Vector3d(x0, y1, 0.0)};
+  return m;
+}
+
+// A partial map element is judged against the part of its marking that was seen: the rectangle
+// of the seen part matches, a whole-marking guess does not; a marking seen whole matches as
+// its own center.
+TEST(ViewCeiling, SeenPartsMatchWhatWasSeen) {
+  GroundTruth gt = StraightDrive();
+  gt.markings.push_back(Rectangle(1, 60.0, 64.0, -5.0, 45.0, 30));   // wider than the view
+  gt.markings.push_back(Rectangle(2, 30.0, 33.0, -0.25, 0.25, 30));  // a stripe
+  gt.markings.push_back(Rectangle(3, 30.0, 33.0, 1.75, 2.25, 0));    // never in the masks
+  const EvaluationOptions options;
+  const ViewCeilingMetrics ceiling = EvaluateViewCeiling(gt, options);
+  const Eigen::Vector3d seen = ceiling.markings[0].in_view_center_map;
+  ASSERT_TRUE(seen.allFinite());
+
+  VectorMap map;
+  // The seen part's rectangle, 0.3 m off across: on its seen part.
+  map.markings.push_back(MapRectangle(7, 60.3, 64.3, -5.0, 2.0 * seen.y() + 5.0));
+  map.markings.push_back(MapRectangle(8, 30.1, 33.1, -0.25, 0.25));
+  SeenPartMetrics parts = EvaluateSeenParts(map, gt, ceiling, options);
+  ASSERT_EQ(parts.gt_seen, 2);
+  ASSERT_EQ(parts.markings.size(), 2u);
+  EXPECT_TRUE(parts.markings[0].matched);
+  EXPECT_EQ(parts.markings[0].map_id, 7u);
+  EXPECT_NEAR(parts.markings[0].center_error_m, 0.3, 0.05);
+  EXPECT_TRUE(parts.markings[1].matched);
+  EXPECT_NEAR(parts.markings[1].center_error_m, 0.1, 1e-9);
+  EXPECT_DOUBLE_EQ(parts.recall, 1.0);
+  EXPECT_NEAR(parts.center_error_max_m, 0.3, 0.05);
+
+  // The whole crossing drawn where the truth has it is no map of what was seen.
+  map.markings[0] = MapRectangle(7, 60.0, 64.0, -5.0, 45.0);
+  parts = EvaluateSeenParts(map, gt, ceiling, options);
+  EXPECT_FALSE(parts.markings[0].matched);
+  EXPECT_TRUE(std::isnan(parts.markings[0].center_error_m));
+  EXPECT_EQ(parts.matched, 1);
+  EXPECT_DOUBLE_EQ(parts.recall, 0.5);
+}
+
 // A hostile ground truth (a marking kilometres wide, lane points kilometres apart, NaN) is
 // judged without a sample per centimetre of it.
 TEST(ViewCeiling, AbsurdGroundTruthStaysCheap) {

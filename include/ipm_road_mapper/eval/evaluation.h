@@ -231,6 +231,7 @@ struct Metrics {
   PoseMetrics poses;
   StorageMetrics storage;
   ViewCeilingMetrics ceiling;
+  SeenPartMetrics seen_parts;
   EvaluationOptions options;
 };
 

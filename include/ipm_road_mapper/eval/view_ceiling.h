@@ -19,9 +19,12 @@
 // EvaluateMarkings count recall; the F1 ceiling takes precision 1.
 #pragma once
 
+#include <Eigen/Core>
+#include <cstdint>
 #include <vector>
 
 #include "ipm_road_mapper/core/io/ground_truth.h"
+#include "ipm_road_mapper/core/map/vector_map.h"
 
 namespace ipm_road_mapper {
 
@@ -37,8 +40,9 @@ struct ViewCeilingMarking {
   int gt_id = 0;
   int visible_frames = 0;         // the GT's own count (frames whose mask holds it)
   double in_view_fraction = 0.0;  // share of its samples in view
-  // Distance from the center of the in-view part's rectangle to the marking's center; NaN
+  // Center of the in-view part's rectangle, and its distance to the marking's center; NaN
   // when no sample is in view.
+  Eigen::Vector3d in_view_center_map = Eigen::Vector3d::Zero();
   double in_view_center_offset_m = 0.0;
   bool reachable = false;  // visible_frames > 0 and the offset within marking_gate_m
 };
@@ -56,9 +60,34 @@ struct ViewCeilingMetrics {
   std::vector<ViewCeilingMarking> markings;
 };
 
+// What the map got right of what was seen: each GT marking the masks hold and some frame saw
+// is matched, by class and within marking_gate_m, to the map marking nearest the center of
+// its in-view part (one-to-one, nearest pairs first, as EvaluateMarkings matches the whole
+// markings). A marking seen whole has its own center there; one wider than the view is judged
+// by the part a map could know. A diagnostic beside the marking recall and APE, not instead.
+struct SeenPartMarking {
+  int gt_id = 0;
+  bool matched = false;
+  std::uint64_t map_id = 0;   // valid when matched
+  double center_error_m = 0;  // map center to the in-view part's center; NaN unless matched
+};
+struct SeenPartMetrics {
+  int gt_seen = 0;  // GT markings with visible_frames > 0 and some sample in view
+  int matched = 0;
+  double recall = 0.0;             // matched / gt_seen; NaN without any
+  double center_error_mean_m = 0;  // NaN without a match
+  double center_error_max_m = 0;
+  std::vector<SeenPartMarking> markings;  // per GT marking counted in gt_seen
+};
+
 // The ceiling of `gt`'s drive (see above). Cost: per GT point, the frames within
 // view_range_m of it (a grid index over the true positions), stopping at the first that sees
 // it.
 ViewCeilingMetrics EvaluateViewCeiling(const GroundTruth& gt, const EvaluationOptions& options);
+
+// The map's markings against the in-view parts `ceiling` found for `gt` (SeenPartMetrics).
+SeenPartMetrics EvaluateSeenParts(const VectorMap& map, const GroundTruth& gt,
+                                  const ViewCeilingMetrics& ceiling,
+                                  const EvaluationOptions& options);
 
 }  // namespace ipm_road_mapper
