@@ -2,8 +2,9 @@
 # End-to-end test of evaluate_map and plot_map.py (with and without ground truth) on a small
 # drive written here: a 160 m road (straight, then an arc) with 3 lane lines, 10 markings and
 # 100 frames, and a map with known damage (marking offsets, a duplicate, a false positive, a
-# split lane, a lateral lane offset, an extrinsic error, pose noise). Run by ctest in the
-# devel space's environment.
+# split lane, a lateral lane offset, an extrinsic error, pose noise), and the view's ceiling
+# of the drive (every line and seen marking reachable). Run by ctest in the devel space's
+# environment.
 set -e -o pipefail
 
 PYTHON=/usr/bin/python3
@@ -181,6 +182,18 @@ check(abs(m["pose_yaw_err_deg_input"] - 0.004 * 180 / 3.141592653589793) < 1e-4,
 check(m["map_bytes"] == os.path.getsize(sys.argv[2]), "map_bytes is the file size")
 check(m["map_bytes_per_km"] > 0 and m["control_points_per_km"] > 300, "storage")
 check(len(m["markings"]) == 11 and len(m["lanes"]) == 4 and len(m["poses"]) == 100, "arrays")
+# The view's ceiling: the drive sees every line and every marking the masks hold (the unseen
+# one is not counted); the map's markings lie on the seen parts as on the whole markings.
+check(m["ceiling_view_range_m"] == 40.0, "ceiling_view_range_m")
+check(m["ceiling_lanes_reachable"] == 3 and m["ceiling_lane_f1"] == 1.0, "ceiling lanes %s"
+      % m["ceiling_lanes_reachable"])
+check(m["ceiling_markings_reachable"] == 9 and m["ceiling_marking_recall"] == 1.0,
+      "ceiling markings %s" % m["ceiling_markings_reachable"])
+check(len(m["ceiling_markings"]) == 10 and len(m["ceiling_lanes"]) == 3, "ceiling arrays")
+check(m["seen_part_gt"] == 9 and m["seen_part_matched"] == m["marking_matched"]
+      and abs(m["seen_part_ape_mean_m"] - m["marking_ape_mean_m"]) < 0.05,
+      "seen parts %s / %s, %s" % (m["seen_part_matched"], m["seen_part_gt"],
+                                  m["seen_part_ape_mean_m"]))
 EOF
 
 evaluate_map --map "$work/map.json" --ground-truth "$work/gt.json" --json "$work/m2.json" \
