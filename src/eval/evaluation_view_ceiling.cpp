@@ -19,8 +19,8 @@ constexpr std::size_t kLaneChunkPoints = 50;
 constexpr double kLaneChunkRadiusM = 5.0;
 // Most samples of one marking: a larger one is sampled more coarsely.
 constexpr double kMaxMarkingSamples = 1e5;
-// A GT marking wider than this (no painted marking is) is not looked for: a hostile ground
-// truth stays cheap.
+// A GT marking with a corner farther than this from its center (no painted marking has one)
+// is not looked for: a hostile ground truth stays cheap.
 constexpr double kMaxMarkingRadiusM = 200.0;
 // Cell side of the index over the frames' true positions.
 constexpr double kFrameCellM = 10.0;

@@ -12,8 +12,8 @@
 //   axes, has its center within marking_gate_m of the marking's: a map that records what was
 //   seen and guesses no unseen end (the mapper's partial elements, `complete: false`) can
 //   put it there at best. Its in-view part is sampled on a grid every
-//   view_marking_sample_spacing_m (coarser beyond 1e5 samples); a GT marking more than 200 m
-//   across is not looked for (unreachable).
+//   view_marking_sample_spacing_m (coarser beyond 1e5 samples); a GT marking with a corner
+//   more than 200 m from its center is not looked for (unreachable).
 // The recall ceilings count reachable GT lanes over all GT lanes, reachable GT markings over
 // the GT markings the drive's masks hold (visible_frames > 0), as EvaluateLanes and
 // EvaluateMarkings count recall; the F1 ceiling takes precision 1.
