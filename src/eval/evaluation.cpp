@@ -14,13 +14,6 @@
 namespace ipm_road_mapper {
 namespace {
 
-// A candidate marking match: same class, centers within the gate.
-struct Candidate {
-  double distance_m;
-  int map_index;
-  int gt_index;
-};
-
 // Mean corner distance under the best cyclic correspondence of the 4 corners (both sets
 // are in the same rotational sense, so only the 4 cyclic shifts are tried).
 double CornerError(const std::array<Eigen::Vector3d, 4>& map_corners,
@@ -34,45 +27,43 @@ double CornerError(const std::array<Eigen::Vector3d, 4>& map_corners,
   return best;
 }
 
-// Most candidate pairs GatedCandidates collects: only markings piled on each other (a
+// Most candidate pairs GatedMarkingPairs collects: only markings piled on each other (a
 // hostile map) come near it, and they would otherwise cost N * M memory.
 constexpr std::size_t kMaxMarkingCandidates = 10'000'000;
 
-// All same-class pairs within the gate, nearest first (ties broken by index: deterministic).
-// GT markings are searched in a window of +-gate_m in x (sorted by center x), so spread-out
-// maps cost O(N log M); a MapFormatError when the pairs exceed kMaxMarkingCandidates.
-std::vector<Candidate> GatedCandidates(const VectorMap& map, const GroundTruth& gt, double gate_m) {
-  std::vector<std::pair<double, int>> gt_by_x;  // (center x, GT index)
-  gt_by_x.reserve(gt.markings.size());
-  for (std::size_t j = 0; j < gt.markings.size(); ++j) {
-    gt_by_x.emplace_back(gt.markings[j].center_map.x(), static_cast<int>(j));
+}  // namespace
+
+std::vector<MarkingPair> GatedMarkingPairs(const VectorMap& map,
+                                           const std::vector<MarkingTarget>& targets,
+                                           double gate_m) {
+  std::vector<std::pair<double, int>> by_x;  // (target center x, target index)
+  by_x.reserve(targets.size());
+  for (std::size_t j = 0; j < targets.size(); ++j) {
+    by_x.emplace_back(targets[j].center_map.x(), static_cast<int>(j));
   }
-  std::sort(gt_by_x.begin(), gt_by_x.end());
-  std::vector<Candidate> candidates;
+  std::sort(by_x.begin(), by_x.end());
+  std::vector<MarkingPair> pairs;
   for (std::size_t i = 0; i < map.markings.size(); ++i) {
     const Eigen::Vector3d center = map.markings[i].Center();
-    auto it =
-        std::lower_bound(gt_by_x.begin(), gt_by_x.end(), std::make_pair(center.x() - gate_m, -1));
-    for (; it != gt_by_x.end() && it->first <= center.x() + gate_m; ++it) {
+    auto it = std::lower_bound(by_x.begin(), by_x.end(), std::make_pair(center.x() - gate_m, -1));
+    for (; it != by_x.end() && it->first <= center.x() + gate_m; ++it) {
       const int j = it->second;
-      if (gt.markings[j].class_id != map.markings[i].class_id) continue;
-      const double distance = (center - gt.markings[j].center_map).norm();
+      if (targets[j].class_id != map.markings[i].class_id) continue;
+      const double distance = (center - targets[j].center_map).norm();
       if (distance > gate_m) continue;
-      candidates.push_back({distance, static_cast<int>(i), j});
-      if (candidates.size() > kMaxMarkingCandidates) {
+      pairs.push_back({distance, static_cast<int>(i), j});
+      if (pairs.size() > kMaxMarkingCandidates) {
         throw MapFormatError("map markings: more than " + std::to_string(kMaxMarkingCandidates) +
                              " same-class map/GT pairs within the gate (markings piled up)");
       }
     }
   }
-  std::sort(candidates.begin(), candidates.end(), [](const Candidate& a, const Candidate& b) {
-    return std::tie(a.distance_m, a.map_index, a.gt_index) <
-           std::tie(b.distance_m, b.map_index, b.gt_index);
+  std::sort(pairs.begin(), pairs.end(), [](const MarkingPair& a, const MarkingPair& b) {
+    return std::tie(a.distance_m, a.map_index, a.target_index) <
+           std::tie(b.distance_m, b.map_index, b.target_index);
   });
-  return candidates;
+  return pairs;
 }
-
-}  // namespace
 
 ErrorSummary Summarize(std::vector<double> values) {
   ErrorSummary summary;
@@ -124,11 +115,15 @@ MarkingMetrics EvaluateMarkings(const VectorMap& map, const GroundTruth& gt,
 
   // Greedy one-to-one assignment by increasing center distance; a map marking whose
   // nearest in-gate GT marking is taken already is a duplicate of it.
-  std::vector<Candidate> candidates = GatedCandidates(map, gt, options.marking_gate_m);
+  std::vector<MarkingTarget> targets;
+  targets.reserve(gt.markings.size());
+  for (const GroundTruthMarking& g : gt.markings) targets.push_back({g.center_map, g.class_id});
+  const std::vector<MarkingPair> candidates =
+      GatedMarkingPairs(map, targets, options.marking_gate_m);
   std::vector<bool> map_done(map.markings.size(), false);
-  for (const Candidate& c : candidates) {
+  for (const MarkingPair& c : candidates) {
     MapMarkingResult& m = metrics.map_markings[c.map_index];
-    GroundTruthMarkingResult& g = metrics.gt_markings[c.gt_index];
+    GroundTruthMarkingResult& g = metrics.gt_markings[c.target_index];
     if (map_done[c.map_index]) continue;
     if (g.matched) continue;
     map_done[c.map_index] = true;
@@ -136,18 +131,18 @@ MarkingMetrics EvaluateMarkings(const VectorMap& map, const GroundTruth& gt,
     g.map_id = m.map_id;
     m.verdict = MarkingVerdict::kMatched;
     m.gt_id = g.gt_id;
-    const GroundTruthMarking& truth = gt.markings[c.gt_index];
+    const GroundTruthMarking& truth = gt.markings[c.target_index];
     m.center_error_map = m.center_map - truth.center_map;
     m.center_error_m = c.distance_m;
     m.corner_error_m = CornerError(map.markings[c.map_index].corners_map, truth.corners_map);
   }
-  for (const Candidate& c : candidates) {  // nearest first: each duplicate names its nearest
+  for (const MarkingPair& c : candidates) {  // nearest first: each duplicate names its nearest
     MapMarkingResult& m = metrics.map_markings[c.map_index];
-    if (map_done[c.map_index] || !metrics.gt_markings[c.gt_index].matched) continue;
+    if (map_done[c.map_index] || !metrics.gt_markings[c.target_index].matched) continue;
     map_done[c.map_index] = true;
     m.verdict = MarkingVerdict::kDuplicate;
-    m.gt_id = metrics.gt_markings[c.gt_index].gt_id;
-    ++metrics.gt_markings[c.gt_index].duplicates;
+    m.gt_id = metrics.gt_markings[c.target_index].gt_id;
+    ++metrics.gt_markings[c.target_index].duplicates;
   }
 
   std::vector<double> center_errors, corner_errors, complete_center_errors;

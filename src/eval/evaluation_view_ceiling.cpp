@@ -3,7 +3,6 @@
 #include <algorithm>
 #include <cmath>
 #include <numeric>
-#include <tuple>
 
 #include "ipm_road_mapper/core/geometry/pinhole_camera.h"
 #include "ipm_road_mapper/core/mapper/frame_index.h"
@@ -178,32 +177,28 @@ SeenPartMetrics EvaluateSeenParts(const VectorMap& map, const GroundTruth& gt,
                                   const EvaluationOptions& options) {
   SeenPartMetrics metrics;
   metrics.recall = metrics.center_error_mean_m = metrics.center_error_max_m = kNoValue;
-  // (distance, map index, index into metrics.markings), nearest first.
-  std::vector<std::tuple<double, std::size_t, std::size_t>> pairs;
+  // One target per GT marking the masks hold and some frame saw: its seen part's center.
+  std::vector<MarkingTarget> targets;
   for (std::size_t j = 0; j < gt.markings.size() && j < ceiling.markings.size(); ++j) {
     const ViewCeilingMarking& seen = ceiling.markings[j];
     if (seen.visible_frames <= 0 || !seen.in_view_center_map.allFinite()) continue;
+    targets.push_back({seen.in_view_center_map, gt.markings[j].class_id});
     SeenPartMarking result;
     result.gt_id = seen.gt_id;
     result.center_error_m = kNoValue;
     metrics.markings.push_back(result);
-    for (std::size_t i = 0; i < map.markings.size(); ++i) {
-      if (map.markings[i].class_id != gt.markings[j].class_id) continue;
-      const double d = (map.markings[i].Center() - seen.in_view_center_map).norm();
-      if (d <= options.marking_gate_m) pairs.emplace_back(d, i, metrics.markings.size() - 1);
-    }
   }
-  std::sort(pairs.begin(), pairs.end());
+  // Greedy one-to-one by increasing distance, as EvaluateMarkings.
   std::vector<bool> map_used(map.markings.size(), false);
   std::vector<double> errors;
-  for (const auto& [d, i, k] : pairs) {
-    SeenPartMarking& result = metrics.markings[k];
-    if (map_used[i] || result.matched) continue;
-    map_used[i] = true;
+  for (const MarkingPair& pair : GatedMarkingPairs(map, targets, options.marking_gate_m)) {
+    SeenPartMarking& result = metrics.markings[pair.target_index];
+    if (map_used[pair.map_index] || result.matched) continue;
+    map_used[pair.map_index] = true;
     result.matched = true;
-    result.map_id = map.markings[i].id;
-    result.center_error_m = d;
-    errors.push_back(d);
+    result.map_id = map.markings[pair.map_index].id;
+    result.center_error_m = pair.distance_m;
+    errors.push_back(pair.distance_m);
   }
   metrics.gt_seen = static_cast<int>(metrics.markings.size());
   metrics.matched = static_cast<int>(errors.size());

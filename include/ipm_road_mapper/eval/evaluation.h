@@ -235,6 +235,26 @@ struct Metrics {
   EvaluationOptions options;
 };
 
+// A center map markings are matched to: a GT marking's, or the center of its seen part.
+struct MarkingTarget {
+  Eigen::Vector3d center_map = Eigen::Vector3d::Zero();
+  int class_id = 0;
+};
+// A candidate match: a map marking and a target of its class, centers within the gate.
+struct MarkingPair {
+  double distance_m = 0.0;
+  int map_index = 0;
+  int target_index = 0;
+};
+
+// All same-class (map marking, target) pairs whose centers are within gate_m, nearest first
+// (ties broken by index: deterministic). Targets are searched in a window of +-gate_m in x
+// (sorted by center x), so spread-out maps cost O(N log M); a MapFormatError when the pairs
+// exceed ten million (markings piled on each other: a hostile map).
+std::vector<MarkingPair> GatedMarkingPairs(const VectorMap& map,
+                                           const std::vector<MarkingTarget>& targets,
+                                           double gate_m);
+
 // Matches mapped markings to GT markings (same class, center within the gate, one-to-one,
 // greedily by increasing distance) and measures their errors.
 MarkingMetrics EvaluateMarkings(const VectorMap& map, const GroundTruth& gt,
