@@ -39,8 +39,10 @@ std::string MapperSummaryLines(const Mapper& mapper, const FrameAssembler& assem
   }
   s << "map: " << map.markings.size() << " markings, " << map.lanes.size() << " lanes (created "
     << c.markings_created << " markings, " << c.lanes_created << " lanes; spurious dropped "
-    << c.spurious_dropped << ", lanes merged " << c.lanes_merged << ", joined " << c.lanes_joined
-    << " (" << c.lanes_joined_hidden_gap << " across a gap out of view)"
+    << c.spurious_dropped << ", inconsistent " << c.markings_inconsistent << ", far-only dropped "
+    << c.far_markings_dropped << ", restarted near " << c.far_markings_restarted
+    << ", lanes merged " << c.lanes_merged << ", joined " << c.lanes_joined << " ("
+    << c.lanes_joined_hidden_gap << " across a gap out of view)"
     << ", lane observations unused " << c.lane_observations_unused << ", near a lane "
     << c.lane_observations_near_lane << ", along a lane of another class "
     << c.lane_observations_other_class << ")\n"

@@ -159,6 +159,28 @@ TEST_F(InstanceExtractionTest, FarMarkingIsDroppedByRange) {
   EXPECT_EQ(ExtractRectangle({45.0, 0.0}, 3.0, 3.0, 0.0, kArrow).markings.size(), 1u);
 }
 
+TEST_F(InstanceExtractionTest, FarWholeViewIsKeptAsAFarViewFarPartialOneIsNot) {
+  options_.max_marking_range_m = 25.0;
+  options_.far_marking_range_m = 50.0;
+  options_.min_marking_pixels = 10;
+  // Beyond the near range, within the far one, whole: a far view.
+  const FrameObservations far = ExtractRectangle({45.0, 0.0}, 3.0, 3.0, 0.0, kArrow);
+  ASSERT_EQ(far.markings.size(), 1u);
+  EXPECT_TRUE(far.markings[0].far);
+  EXPECT_TRUE(far.markings[0].Complete());
+  // Within the near range: no far view.
+  const FrameObservations near = ExtractRectangle({15.0, 0.0}, 3.0, 3.0, 0.0, kArrow);
+  ASSERT_EQ(near.markings.size(), 1u);
+  EXPECT_FALSE(near.markings[0].far);
+  // Cut by the IPM's 50 m range: a far partial view, dropped by range.
+  const FrameObservations cut = ExtractRectangle({49.0, 0.0}, 4.0, 3.0, 0.0, kArrow);
+  EXPECT_TRUE(cut.markings.empty());
+  EXPECT_EQ(cut.counters.dropped_range, 1u);
+  // Off (0): beyond the near range is dropped, as before far views.
+  options_.far_marking_range_m = 0.0;
+  EXPECT_TRUE(ExtractRectangle({45.0, 0.0}, 3.0, 3.0, 0.0, kArrow).markings.empty());
+}
+
 TEST_F(InstanceExtractionTest, MarkingCutByIpmRangeKeepsThePartInRange) {
   // From 45 to 55 m: the part beyond the IPM's 50 m does not map. The part in range is kept
   // (clipped at the range), its far side cut there, its near side and corners measured.

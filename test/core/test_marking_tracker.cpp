@@ -4,6 +4,7 @@
 // is dropped after the spurious horizon.
 #include <gtest/gtest.h>
 
+#include <array>
 #include <cstdint>
 #include <vector>
 
@@ -174,6 +175,71 @@ TEST(MarkingTracker, MarkingSeenEveryFrameIsConfirmed) {
   EXPECT_TRUE(rig.store.markings()[0].confirmed);
   EXPECT_EQ(rig.store.markings()[0].frames_seen, 3u);  // the count ends when confirmed
   EXPECT_EQ(rig.counters.markings_inconsistent, 0u);
+}
+
+// Far views beyond 10 m (the arrow at x in [20, 23] m is 20 m ahead of base_link at x = 0),
+// kept as far views up to 40 m.
+MapperOptions FarViewOptions() {
+  MapperOptions o;
+  o.extraction.max_marking_range_m = 10.0;
+  o.extraction.far_marking_range_m = 40.0;
+  return o;
+}
+
+TEST(MarkingTracker, FarViewsMapAMarkingNoNearViewShowsUntilANearViewRestartsIt) {
+  Rig rig(FarViewOptions());
+  for (int k = 0; k < 4; ++k) rig.Step(RoadFrame(100.0 + 0.05 * k, 0.5 * k));
+  ASSERT_EQ(rig.store.markings().size(), 1u);
+  const MarkingElement far = rig.store.markings()[0];
+  EXPECT_TRUE(far.far_only);
+  EXPECT_TRUE(far.confirmed);
+  EXPECT_EQ(far.history.size(), 4u);
+  EXPECT_NEAR(far.Center().x(), 21.5, 0.3);
+  EXPECT_NEAR(far.Center().y(), 0.0, 0.1);
+  // Seen near (9.5 m): the element starts again from the near view, under its id.
+  rig.Step(RoadFrame(100.20, 12.0));
+  ASSERT_EQ(rig.store.markings().size(), 1u);
+  const MarkingElement& near = rig.store.markings()[0];
+  EXPECT_EQ(near.id, far.id);
+  EXPECT_FALSE(near.far_only);
+  EXPECT_FALSE(near.confirmed);  // confirmed again by near views, as a new element would be
+  EXPECT_EQ(near.history.size(), 1u);
+  EXPECT_EQ(near.history[0].frame_index, 4u);
+  EXPECT_EQ(rig.counters.markings_created, 1u);
+  EXPECT_EQ(rig.counters.far_markings_restarted, 1u);
+  EXPECT_EQ(rig.counters.far_markings_dropped, 0u);
+}
+
+TEST(MarkingTracker, FarOnlyMarkingNoNearViewFindsIsDropped) {
+  // Confirmed by its far views, then not there when the vehicle is within 10 m of it and it
+  // lies in the image: where the far views put it there is nothing, it goes.
+  Rig rig(FarViewOptions());
+  for (int k = 0; k < 4; ++k) rig.Step(RoadFrame(100.0 + 0.05 * k, 0.5 * k));
+  ASSERT_EQ(rig.store.markings().size(), 1u);
+  ASSERT_TRUE(rig.store.markings()[0].confirmed);
+  int dropped_after = -1;
+  for (int k = 0; k < 8 && dropped_after < 0; ++k) {
+    rig.Step(RoadFrame(100.2 + 0.05 * k, 12.0 + 0.2 * k, /*with_arrow=*/false));
+    if (rig.store.markings().empty()) dropped_after = k + 1;
+  }
+  EXPECT_EQ(dropped_after, 4);
+  EXPECT_EQ(rig.counters.far_markings_dropped, 1u);
+}
+
+TEST(MarkingTracker, FarViewIsNoMeasurementOfAMarkingSeenNear) {
+  // Seen near three times, then from 20 m again (backing away): the far views associate
+  // with it and are left out of its history.
+  Rig rig(FarViewOptions());
+  for (int k = 0; k < 3; ++k) rig.Step(RoadFrame(100.0 + 0.05 * k, 12.0 + 0.5 * k));
+  ASSERT_EQ(rig.store.markings().size(), 1u);
+  const std::array<Eigen::Vector3d, 4> corners = rig.store.markings()[0].corners_map;
+  for (int k = 0; k < 3; ++k) rig.Step(RoadFrame(100.2 + 0.05 * k, 1.0 - 0.5 * k));
+  ASSERT_EQ(rig.store.markings().size(), 1u);
+  const MarkingElement& arrow = rig.store.markings()[0];
+  EXPECT_FALSE(arrow.far_only);
+  EXPECT_EQ(arrow.history.size(), 3u);
+  for (int c = 0; c < 4; ++c) EXPECT_EQ(arrow.corners_map[c], corners[c]);
+  EXPECT_EQ(rig.counters.markings_created, 1u);
 }
 
 }  // namespace

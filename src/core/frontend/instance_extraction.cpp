@@ -157,6 +157,12 @@ ExtractionOptions LoadExtractionOptions(OptionsReader reader) {
   });
   reader.Read<int>("max_instances_per_frame", &o.max_instances_per_frame, CheckPositiveInt);
   reader.Read<double>("max_marking_range_m", &o.max_marking_range_m, CheckPositive);
+  reader.Read<double>(
+      "far_marking_range_m", &o.far_marking_range_m, [&o](const double& v) -> std::string {
+        return v == 0.0 || v >= o.max_marking_range_m
+                   ? ""
+                   : "must be 0 (off) or >= max_marking_range_m (got " + std::to_string(v) + ")";
+      });
   reader.Read<double>("min_rectangle_side_m", &o.min_rectangle_side_m, CheckNonNegative);
   reader.Read<int>("max_plausible_instances", &o.max_plausible_instances, CheckPositiveInt);
   reader.Read<double>("max_coverage", &o.max_coverage, [](const double& v) -> std::string {

@@ -243,7 +243,10 @@ GeometryOutcome ExtractMarking(const Run* runs, int run_count, const cv::Mat& ma
   const std::array<Eigen::Vector2d, 4> rectangle =
       BoundingRectangle(marking->outline_base, Eigen::Vector2d::UnitX());
   const Eigen::Vector2d center = 0.25 * (rectangle[0] + rectangle[1] + rectangle[2] + rectangle[3]);
-  if (center.norm() > options.max_marking_range_m) return GeometryOutcome::kRange;
+  marking->far = center.norm() > options.max_marking_range_m;
+  if (marking->far && !(center.norm() <= options.far_marking_range_m)) {
+    return GeometryOutcome::kRange;
+  }
   if (std::min((rectangle[1] - rectangle[0]).norm(), (rectangle[2] - rectangle[1]).norm()) <
       options.min_rectangle_side_m) {
     return GeometryOutcome::kDegenerate;
@@ -257,6 +260,9 @@ GeometryOutcome ExtractMarking(const Run* runs, int run_count, const cv::Mat& ma
   // (a whole-image blob, one leaving the image on three sides): truncated, no observation.
   const std::array<bool, 4>& sides = marking->side_measured;
   if (sides[0] + sides[1] + sides[2] + sides[3] < 2) return GeometryOutcome::kTruncated;
+  // A far view locates a marking meters off along the view: only its whole shape tells which
+  // marking it is (a cut one grows no extent; docs/backend.md, "Far views").
+  if (marking->far && !marking->Complete()) return GeometryOutcome::kRange;
   return GeometryOutcome::kOk;
 }
 GeometryOutcome ExtractLane(const Run* runs, int run_count, const ClassInfo& class_info,

@@ -185,7 +185,12 @@ void Mapper::Reset() {
 bool Mapper::Finish(double time_budget_s) {
   const bool finished = windows_.Finish(time_budget_s);
   // The camera for the joins across a gap no frame saw (those are joined here only).
-  if (counters_.frames_used > 0) lanes_.SetCamera(windows_.camera(), windows_.T_base_cam());
+  if (counters_.frames_used > 0) {
+    lanes_.SetCamera(windows_.camera(), windows_.T_base_cam());
+    // The far-only markings on the final poses and extrinsic.
+    markings_.RefreshFarOnly(PinholeCamera(windows_.camera()), windows_.T_base_cam(),
+                             /*include_retired=*/true);
+  }
   lanes_.JoinFragments();  // fragments the drive's last frames left apart
   store_.NoteRemovals();
   return finished;

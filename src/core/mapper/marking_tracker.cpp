@@ -8,6 +8,7 @@
 #include "ipm_road_mapper/core/frontend/association.h"
 #include "ipm_road_mapper/core/frontend/frame_registration.h"
 #include "ipm_road_mapper/core/frontend/instance_extraction.h"
+#include "ipm_road_mapper/core/mapper/far_marking_estimate.h"
 #include "ipm_road_mapper/core/mapper/marking_extent.h"
 #include "ipm_road_mapper/core/mapper/marking_pixel_agreement.h"
 #include "ipm_road_mapper/core/mapper/shared_frames.h"
@@ -42,6 +43,41 @@ constexpr double kRoadAxisMinAngleRad = 1e-3;
 constexpr std::size_t kMinSeenToConfirm = 3;
 constexpr double kMinSeenFraction = 0.5;
 constexpr std::size_t kMinExpectedToJudge = 4;
+
+// The weight of a far view in a far-only element's mean: the inverse of its center's
+// plain-IPM variance (Omega_p's x-y trace, m^2).
+double FarViewWeight(const MarkingCandidate& candidate) {
+  return 1.0 / std::max(candidate.center_cov_map.trace(), 1e-6);
+}
+
+// An element made by one view.
+MarkingElement NewElement(const MarkingObservation& obs, const MarkingCandidate& candidate,
+                          const FrameRecord& frame) {
+  MarkingElement element;
+  element.class_id = obs.class_id;
+  element.corners_map = candidate.corners_map;
+  element.center_cov_map = candidate.center_cov_map;
+  element.side_measured = obs.side_measured;
+  for (int s = 0; s < 4; ++s) element.side_views[s] = obs.side_measured[s] ? 1 : 0;
+  element.history.push_back(MeasurementOf(obs, frame.index, 0));
+  element.first_frame = element.last_frame = frame.index;
+  element.first_seen = element.last_seen = frame.stamp;
+  element.farthest_view_m = obs.center_base.head<2>().norm();
+  element.far_only = obs.far;
+  if (obs.far) element.far_weight = FarViewWeight(candidate);
+  return element;
+}
+
+// Replaces a far-only element by `fresh` (made by a near view), keeping its id and what the
+// incremental export knows of it. Its confirmation starts again with the near views: from
+// here on it is the element they alone would have made.
+void RestartFromNearView(MarkingElement fresh, MarkingElement* element) {
+  fresh.id = element->id;
+  fresh.revision = element->revision;
+  fresh.exported_at = element->exported_at;
+  fresh.retired = element->retired;
+  *element = std::move(fresh);
+}
 
 // Largest horizontal distance of a corner from the center.
 double Radius(const MarkingElement& e) {
@@ -81,6 +117,8 @@ void Absorb(MarkingElement* first, const MarkingElement& second) {
   first->frames_seen += second.frames_seen;
   first->frames_expected = std::max(first->frames_expected, second.frames_expected);
   first->farthest_view_m = std::max(first->farthest_view_m, second.farthest_view_m);
+  first->far_weight += second.far_weight;
+  first->near_frames_expected = std::max(first->near_frames_expected, second.near_frames_expected);
   if (second.center_cov_map.trace() < first->center_cov_map.trace()) {
     first->center_cov_map = second.center_cov_map;
   }
@@ -98,6 +136,7 @@ void MarkingTracker::Update(const Ipm& ipm, const FrameRecord& frame,
   OrientAlongRoad(ipm, frame, observations);
 
   Associate(*observations, frame, offset_across_m);
+  RefreshFarOnly(ipm.camera(), ipm.T_base_cam(), /*include_retired=*/false);
   CheckConsistency(ipm, frame);
   MergeDuplicates(ipm);
 }
@@ -177,23 +216,24 @@ void MarkingTracker::Associate(const std::vector<MarkingObservation>& observatio
   for (std::size_t c = 0; c < candidates.size(); ++c) {
     const MarkingObservation& obs = observations[c];
     if (match[c] < 0) {
-      MarkingElement element;
+      MarkingElement element = NewElement(obs, candidates[c], frame);
       element.id = store_->NewId();
-      element.class_id = obs.class_id;
-      element.corners_map = candidates[c].corners_map;
-      element.center_cov_map = candidates[c].center_cov_map;
-      element.side_measured = obs.side_measured;
-      for (int s = 0; s < 4; ++s) element.side_views[s] = obs.side_measured[s] ? 1 : 0;
-      element.history.push_back(MeasurementOf(obs, frame.index, 0));
-      element.first_frame = element.last_frame = frame.index;
-      element.first_seen = element.last_seen = frame.stamp;
-      element.farthest_view_m = obs.center_base.head<2>().norm();
       store_->Touch(&element);
       markings.push_back(std::move(element));
       ++counters_->markings_created;
       continue;
     }
     MarkingElement& element = markings[match[c]];
+    // A nearer view locates the marking: a far one is no measurement of it. A far-only
+    // element seen near starts again from that view (as if the view had made it).
+    if (obs.far && !element.far_only) continue;
+    if (!obs.far && element.far_only) {
+      MarkingElement fresh = NewElement(obs, candidates[c], frame);
+      RestartFromNearView(std::move(fresh), &element);
+      store_->Touch(&element);
+      ++counters_->far_markings_restarted;
+      continue;
+    }
     store_->Touch(&element);
     // Whole views pair corners by distance (as always); a partial view by side direction.
     const bool whole = element.Complete() && candidates[c].complete;
@@ -211,10 +251,16 @@ void MarkingTracker::Associate(const std::vector<MarkingObservation>& observatio
     std::array<Eigen::Vector3d, 4> observed_map;
     for (int i = 0; i < 4; ++i) observed_map[i] = candidates[c].corners_map[(i + shift) % 4];
     if (whole && !element.optimized) {
-      // Plain IPM estimate: the running mean of the observed corners in the map.
-      const double n = static_cast<double>(element.Observations());
+      // Plain IPM estimate: the running mean of the observed corners in the map (far views:
+      // weighted by their Omega_p, whose range error grows as d^2).
+      double step = 1.0 / static_cast<double>(element.Observations());
+      if (element.far_only) {
+        const double weight = FarViewWeight(candidates[c]);
+        element.far_weight += weight;
+        step = weight / element.far_weight;
+      }
       for (int i = 0; i < 4; ++i) {
-        element.corners_map[i] += (observed_map[i] - element.corners_map[i]) / n;
+        element.corners_map[i] += step * (observed_map[i] - element.corners_map[i]);
         ++element.side_views[i];
       }
       continue;
@@ -227,15 +273,23 @@ void MarkingTracker::Associate(const std::vector<MarkingObservation>& observatio
 void MarkingTracker::CheckConsistency(const Ipm& ipm, const FrameRecord& frame) {
   const Eigen::Isometry3d T_base_map = frame.T_map_base.inverse();
   const CameraIntrinsics& in = ipm.camera().intrinsics();
+  const double near_range_m = options_.extraction.max_marking_range_m;
   for (MarkingElement& m : store_->markings()) {
-    if (m.confirmed || m.retired) continue;
+    if (m.retired) continue;
     const bool seen = m.last_frame == frame.index;
     const Eigen::Vector3d center_base = ipm.OnGround((T_base_map * m.Center()).head<2>());
     Eigen::Vector2d uv;
+    const auto in_image = [&] {
+      return ipm.BaseToPixel(center_base, &uv) && uv.x() >= 0.0 && uv.y() >= 0.0 &&
+             uv.x() <= in.width - 1.0 && uv.y() <= in.height - 1.0;
+    };
+    // A far-only element come within near range: a near view should find it there.
+    if (m.far_only && !seen && center_base.head<2>().norm() <= near_range_m && in_image()) {
+      ++m.near_frames_expected;
+    }
+    if (m.confirmed) continue;
     // Where a view saw it already or nearer, with its center in the image: it should be seen.
-    const bool expected = center_base.head<2>().norm() <= m.farthest_view_m &&
-                          ipm.BaseToPixel(center_base, &uv) && uv.x() >= 0.0 && uv.y() >= 0.0 &&
-                          uv.x() <= in.width - 1.0 && uv.y() <= in.height - 1.0;
+    const bool expected = center_base.head<2>().norm() <= m.farthest_view_m && in_image();
     if (!seen && !expected) continue;
     ++m.frames_expected;
     if (seen) ++m.frames_seen;
@@ -268,7 +322,9 @@ void MarkingTracker::MergeDuplicates(const Ipm& ipm) {
   auto gate_candidates = [&](std::size_t a, std::size_t b) {
     const MarkingElement& x = markings[a];
     const MarkingElement& y = markings[b];
-    return a != b && !y.retired && x.class_id == y.class_id &&
+    // Far-only elements are uncertain by far-view IPM (meters), not by where their refreshed
+    // estimate lies: they meet a near-seen element only by place (distance, overlap).
+    return a != b && !y.retired && x.class_id == y.class_id && x.far_only == y.far_only &&
            gate_distance2(x, y) <= sigma_gate2 && !SeenInOneFrame(x, y);
   };
   // Whether b is a's nearest gate candidate. The gate grows with the stated odometry noise
@@ -302,6 +358,7 @@ void MarkingTracker::MergeDuplicates(const Ipm& ipm) {
   auto pixels_agree = [&](std::size_t a, std::size_t b) {
     const MarkingElement& x = markings[a];
     const MarkingElement& y = markings[b];
+    if (x.far_only != y.far_only) return false;
     if (SeenInOneFrame(x, y) || !nearest_unseen(a, b) || !nearest_unseen(b, a)) return false;
     const bool x_model = x.center_cov_map.trace() <= y.center_cov_map.trace();
     return PixelsAgree(ipm, options_.ipm.error_model, o.marking_gate_sigmas, store_->frames(),
@@ -328,16 +385,45 @@ void MarkingTracker::MergeDuplicates(const Ipm& ipm) {
         ++b;
         continue;
       }
-      // The better-observed element stays (its id and its corners).
-      if (markings[b].Observations() > markings[a].Observations()) {
-        std::swap(markings[a], markings[b]);
+      if (markings[a].far_only != markings[b].far_only) {
+        // The element near views made stays as it is: far views are no measurement of it.
+        if (markings[a].far_only) std::swap(markings[a], markings[b]);
+        store_->Touch(&markings[a]);
+      } else {
+        // The better-observed element stays (its id and its corners).
+        if (markings[b].Observations() > markings[a].Observations()) {
+          std::swap(markings[a], markings[b]);
+        }
+        Absorb(&markings[a], markings[b]);
+        store_->Touch(&markings[a]);
       }
-      Absorb(&markings[a], markings[b]);
-      store_->Touch(&markings[a]);
       markings.erase(markings.begin() + b);
       ++counters_->markings_merged;
     }
   }
+}
+
+void MarkingTracker::RefreshFarOnly(const PinholeCamera& camera,
+                                    const Eigen::Isometry3d& T_base_cam, bool include_retired) {
+  // Moves below this (m) are not changes of the exported map.
+  constexpr double kMinMoveM = 1e-3;
+  const auto refresh = [&](MarkingElement* m) {
+    if (!m->far_only) return false;
+    const std::optional<std::array<Eigen::Vector3d, 4>> corners =
+        FarOnlyEstimate(camera, T_base_cam, options_.ipm.error_model, *store_, *m);
+    if (!corners) return false;
+    double moved = 0.0;
+    for (int c = 0; c < 4; ++c) moved = std::max(moved, ((*corners)[c] - m->corners_map[c]).norm());
+    if (moved < kMinMoveM) return false;
+    m->corners_map = *corners;
+    store_->Touch(m);
+    return true;
+  };
+  for (MarkingElement& m : store_->markings()) refresh(&m);
+  if (!include_retired) return;
+  bool moved = false;
+  for (MarkingElement& m : store_->retired_markings()) moved = refresh(&m) || moved;
+  if (moved) store_->ReindexRetiredMarkings();
 }
 
 void MarkingTracker::DropSpurious(std::size_t frame_index) {
@@ -361,6 +447,17 @@ void MarkingTracker::DropSpurious(std::size_t frame_index) {
                                 }),
                  markings.end());
   counters_->markings_inconsistent += consistent_before - markings.size();
+  // A far-only element that near views did not find where it came into their view: its far
+  // views put it elsewhere than the marking's near views did (a duplicate of it), or nowhere
+  // real. Confirmed or not, it goes.
+  const std::size_t far_before = markings.size();
+  markings.erase(std::remove_if(markings.begin(), markings.end(),
+                                [&](const MarkingElement& e) {
+                                  return e.far_only &&
+                                         e.near_frames_expected >= kMinExpectedToJudge;
+                                }),
+                 markings.end());
+  counters_->far_markings_dropped += far_before - markings.size();
 }
 
 }  // namespace ipm_road_mapper

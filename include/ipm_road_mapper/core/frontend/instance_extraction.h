@@ -15,13 +15,17 @@ namespace ipm_road_mapper {
 
 // Tuning of the extraction (config section `extraction`).
 struct ExtractionOptions {
-  int min_marking_pixels = 150;        // smaller marking instances are dropped (tiny)
-  int min_lane_pixels = 80;            // smaller lane instances are dropped (tiny)
-  int border_margin_px = 2;            // outline edges this close to the border are cut there
-  int lane_row_step = 4;               // take a lane centerline point every this many rows
-  int min_lane_points = 4;             // fewer valid centerline points: degenerate
-  int max_instances_per_frame = 300;   // beyond this, the remaining instances are dropped
-  double max_marking_range_m = 25.0;   // marking whose ground center is farther: dropped
+  int min_marking_pixels = 150;       // smaller marking instances are dropped (tiny)
+  int min_lane_pixels = 80;           // smaller lane instances are dropped (tiny)
+  int border_margin_px = 2;           // outline edges this close to the border are cut there
+  int lane_row_step = 4;              // take a lane centerline point every this many rows
+  int min_lane_points = 4;            // fewer valid centerline points: degenerate
+  int max_instances_per_frame = 300;  // beyond this, the remaining instances are dropped
+  double max_marking_range_m = 25.0;  // marking whose ground center is farther: a far view
+  // Far views (center beyond max_marking_range_m, up to this range) are kept when they show
+  // the whole marking: they map a marking no nearer view shows, never one a nearer view
+  // does, and never enter the back end (MarkingTracker). 0: none (dropped as out of range).
+  double far_marking_range_m = 0.0;
   double min_rectangle_side_m = 0.05;  // thinner ground rectangles are degenerate
   // A frame with more candidate instances than this (known class, not tiny)
   // is no real segmentation: its observations are dropped (the pose is still used).

@@ -48,6 +48,8 @@ struct MarkingObservation {
   Eigen::Vector3d center_base = Eigen::Vector3d::Zero();
   Eigen::Matrix2d center_cov_base = Eigen::Matrix2d::Zero();
   int pixel_count = 0;
+  // Centered beyond ExtractionOptions::max_marking_range_m (a far view: whole, see there).
+  bool far = false;
 };
 
 // One centerline point of a lane instance.

@@ -76,6 +76,14 @@ struct MarkingElement {
   std::size_t frames_seen = 0;
   double farthest_view_m = 0.0;  // largest ground distance of a view's center from base_link
   bool confirmed = false;
+  // Made by far views alone (ExtractionOptions::far_marking_range_m; docs/backend.md, "Far
+  // views"): its estimate is the mean of their IPM weighted by 1 / tr(Omega_p) (far_weight:
+  // the weights' sum), it never enters the back end, and the first near view restarts it
+  // from that view. Where it came within max_marking_range_m with its center in the image,
+  // a near view should have found it: near_frames_expected counts those frames.
+  bool far_only = false;
+  double far_weight = 0.0;
+  std::size_t near_frames_expected = 0;
   // Every observation ever made, pruned ones included.
   std::size_t Observations() const { return history.size() + pruned; }
   // Whether export shows it: seen at least twice (seen once, it is tentative).

@@ -22,6 +22,11 @@ struct MapperCounters {
   std::uint64_t lanes_created = 0;
   std::uint64_t spurious_dropped = 0;
   std::uint64_t markings_inconsistent = 0;  // markings unseen where they should be: dropped
+  // Markings made by far views that no near view found where they came into near view
+  // (MarkingElement::far_only): dropped (the near views made the marking elsewhere, or none).
+  std::uint64_t far_markings_dropped = 0;
+  // ... and those a near view found: restarted from the near views.
+  std::uint64_t far_markings_restarted = 0;
   std::uint64_t lanes_merged = 0;
   std::uint64_t lanes_joined = 0;  // fragments of one line joined end to start (lane_join.h)
   // ... of them across a gap longer than join_max_gap_m that no frame saw (lane_gap_visibility.h)

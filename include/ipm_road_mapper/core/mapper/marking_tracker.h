@@ -35,6 +35,11 @@ class MarkingTracker {
   // association.spurious_after_frames frames, and the tentative ones that frames where they
   // should have been visible did not see (CheckConsistency).
   void DropSpurious(std::size_t frame_index);
+  // Re-estimates the far-only elements (FarOnlyEstimate) with the camera, T_base_cam and the
+  // poses as they are now: the live ones, and the retired ones too when include_retired
+  // (the end of the drive, after the final solve moved the poses).
+  void RefreshFarOnly(const PinholeCamera& camera, const Eigen::Isometry3d& T_base_cam,
+                      bool include_retired);
 
  private:
   // Re-fits each observation's rectangle with sides along the road (the tangent of the
