@@ -105,6 +105,43 @@ TEST(MarkingTracker, LoneCopyWithinTheUncertaintyGateMerges) {
   EXPECT_EQ(rig.store.markings().size(), 2u);
 }
 
+TEST(MarkingTracker, FarOnlyElementMeetsANearOneByPlaceNotByTheGate) {
+  // As above, but the second element was made by far views: its gate is their Omega_p
+  // (meters), wider than a crossing's stripe spacing, so the gate does not pair it with a
+  // near-seen neighbour 1.2 m away (on urban it took a stripe's far-only element into the
+  // next stripe's). Within the merge distance it merges, and the near-seen element stays.
+  Rig rig(NoisyOdometryOptions());
+  rig.Step(RoadFrame(100.0, 0.0));
+  rig.Step(RoadFrame(100.05, 0.5));
+  ASSERT_EQ(rig.store.markings().size(), 1u);
+  const MarkingElement arrow = rig.store.markings()[0];
+  rig.store.markings().push_back(Stripe(&rig, arrow, 30.0, 5.0, 0));
+  const std::uint64_t near_id = rig.store.markings().back().id;
+  MarkingElement far = Stripe(&rig, arrow, 30.0, 6.2, 1);
+  far.far_only = true;
+  // No views to re-estimate it from (the copied ones are the arrow's): it stays where it is.
+  far.history.clear();
+  far.pruned = 2;
+  rig.store.markings().push_back(far);
+  rig.Step(RoadFrame(100.10, 1.0));
+  EXPECT_EQ(rig.counters.markings_merged, 0u);
+  EXPECT_EQ(rig.store.markings().size(), 3u);
+  // 0.3 m away: one marking; the near-seen element stays as it was.
+  for (MarkingElement& m : rig.store.markings()) {
+    if (!m.far_only) continue;
+    for (Eigen::Vector3d& c : m.corners_map) c.y() -= 0.9;
+  }
+  rig.Step(RoadFrame(100.15, 1.5));
+  EXPECT_EQ(rig.counters.markings_merged, 1u);
+  ASSERT_EQ(rig.store.markings().size(), 2u);
+  for (const MarkingElement& m : rig.store.markings()) {
+    if (m.class_id != 11) continue;
+    EXPECT_EQ(m.id, near_id);
+    EXPECT_FALSE(m.far_only);
+    EXPECT_EQ(m.history.size(), 1u);
+  }
+}
+
 TEST(MarkingTracker, CopyAmongEvenlySpacedMarkingsMergesIntoTheNearest) {
   // Three stripes of a crossing 1 m apart, seen together, and an element of their class seen
   // in another frame 1.1 m from the middle one (1.8 m from the first): the gate (meters here)
