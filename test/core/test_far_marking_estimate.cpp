@@ -74,6 +74,26 @@ TEST_F(FarMarkingEstimateTest, FarViewsOnTheRoadPlaneLandWhereTheMarkingIs) {
   }
 }
 
+TEST_F(FarMarkingEstimateTest, AheadOfEveryPoseTheRoadAheadIsThePlane) {
+  // Only the frames on the flat part have been driven (x <= 4 m): the marking 30 m along is
+  // ahead of every pose. The newest pose's own plane (flat) puts it meters too far; the road
+  // ahead as the trajectory knows it (here the grade itself) puts it where it is.
+  MapStore early(6.0);
+  for (int i = 0; i <= 4; ++i) early.AddFrame(100.0 + 0.1 * i, PoseOnRoad(i));
+  const RoadPlane ahead{Eigen::Vector3d(kFlatUntilM, 0.0, 0.0),
+                        Eigen::Vector3d(-kGrade, 0.0, 1.0).normalized()};
+  const std::optional<std::array<Eigen::Vector3d, 4>> on_newest =
+      FarOnlyEstimate(camera_, T_base_cam_, IpmErrorModel(), early, element_);
+  const std::optional<std::array<Eigen::Vector3d, 4>> on_ahead =
+      FarOnlyEstimate(camera_, T_base_cam_, IpmErrorModel(), early, element_, &ahead);
+  ASSERT_TRUE(on_newest.has_value());
+  ASSERT_TRUE(on_ahead.has_value());
+  for (int c = 0; c < 4; ++c) {
+    EXPECT_GT(((*on_newest)[c] - truth_[c]).norm(), 2.0) << "corner " << c;
+    EXPECT_NEAR(((*on_ahead)[c] - truth_[c]).norm(), 0.0, 0.02) << "corner " << c;
+  }
+}
+
 TEST_F(FarMarkingEstimateTest, NoViewThatMapsGivesNoEstimate) {
   for (MarkingMeasurement& meas : element_.history) {
     meas.corners_uv[2] = Eigen::Vector2d(640.0, 0.0);  // above the horizon

@@ -263,6 +263,24 @@ TEST(MarkingTracker, FarOnlyMarkingNoNearViewFindsIsDropped) {
   EXPECT_EQ(rig.counters.far_markings_dropped, 1u);
 }
 
+TEST(MarkingTracker, FarOnlyMarkingThatStopsBeingSeenWhereItShouldBeIsDropped) {
+  // Confirmed by its far views, then no longer seen from 20 m (its center in the image, no
+  // farther than its views were): it stays on probation, and goes once seen in fewer than
+  // half the frames that should have seen it, before any near view could judge it.
+  Rig rig(FarViewOptions());
+  for (int k = 0; k < 4; ++k) rig.Step(RoadFrame(100.0 + 0.05 * k, 0.5 * k));
+  ASSERT_EQ(rig.store.markings().size(), 1u);
+  ASSERT_TRUE(rig.store.markings()[0].confirmed);
+  int dropped_after = -1;
+  for (int k = 0; k < 10 && dropped_after < 0; ++k) {
+    rig.Step(RoadFrame(100.2 + 0.05 * k, 1.5 + 0.05 * k, /*with_arrow=*/false));
+    if (rig.store.markings().empty()) dropped_after = k + 1;
+  }
+  EXPECT_GT(dropped_after, 0);
+  EXPECT_EQ(rig.counters.far_markings_dropped, 1u);
+  EXPECT_EQ(rig.store.markings().empty() ? 0u : rig.store.markings()[0].near_frames_expected, 0u);
+}
+
 TEST(MarkingTracker, FarViewIsNoMeasurementOfAMarkingSeenNear) {
   // Seen near three times, then from 20 m again (backing away): the far views associate
   // with it and are left out of its history.

@@ -31,12 +31,15 @@ std::optional<std::array<Eigen::Vector3d, 4>> FarOnlyEstimate(const PinholeCamer
                                                               const Eigen::Isometry3d& T_base_cam,
                                                               const IpmErrorModel& error_model,
                                                               const MapStore& store,
-                                                              const MarkingElement& element) {
+                                                              const MarkingElement& element,
+                                                              const RoadPlane* road_ahead_map) {
   std::array<Eigen::Vector3d, 4> corners = element.corners_map;
   bool any = false;
   for (int pass = 0; pass < kPlaneLookups; ++pass) {
     const Eigen::Vector3d center = 0.25 * (corners[0] + corners[1] + corners[2] + corners[3]);
-    const RoadPlane plane = store.RoadSurfaceAt(center).plane;
+    const RoadSurfaceEstimate surface = store.RoadSurfaceAt(center);
+    const bool passed = surface.distance_m <= store.road_plane_radius_m();
+    const RoadPlane plane = passed || !road_ahead_map ? surface.plane : *road_ahead_map;
     const Eigen::Vector3d axis = store.RoadDirectionAt(center);
     std::array<Eigen::Vector3d, 4> sum;
     sum.fill(Eigen::Vector3d::Zero());

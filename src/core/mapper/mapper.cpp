@@ -125,6 +125,12 @@ FrameStatus Mapper::ProcessFrame(const FrameInput& input, std::string* reason) {
       FrontEndGround(options_.ipm, store_.frames(), input.stamp, input.T_map_base_odom);
   const Ipm ipm(PinholeCamera(input.camera), windows_.T_base_cam(), options_.ipm.max_range_m,
                 ground_base);
+  // The road ahead, for the far-only markings no pose has passed (far_marking_estimate.h): the
+  // trajectory's plane whatever the front end's ground.
+  IpmOptions trajectory_ground = options_.ipm;
+  trajectory_ground.ground = IpmGround::kTrajectory;
+  const RoadPlane ahead_base =
+      FrontEndGround(trajectory_ground, store_.frames(), input.stamp, input.T_map_base_odom);
   FrameObservations observations =
       ExtractObservations(input.mask, classes_, ipm, options_.ipm.error_model, options_.extraction);
   counters_.extraction.Add(observations.counters);
@@ -139,7 +145,9 @@ FrameStatus Mapper::ProcessFrame(const FrameInput& input, std::string* reason) {
   if (NoiseSetsTheGates(options_.association)) {
     offset_across_m = lanes_.OffsetAcross(lane_association, frame);
   }
-  markings_.Update(ipm, frame, &observations.markings, offset_across_m);
+  const RoadPlane road_ahead_map{frame.T_map_base * ahead_base.point,
+                                 frame.T_map_base.linear() * ahead_base.normal};
+  markings_.Update(ipm, frame, &observations.markings, offset_across_m, &road_ahead_map);
   lanes_.Update(std::move(lane_association), frame);
   markings_.DropSpurious(frame.index);
   lanes_.DropSpurious(frame.index);

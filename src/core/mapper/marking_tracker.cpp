@@ -132,11 +132,12 @@ MarkingTracker::MarkingTracker(const MapperOptions& options, MapStore* store,
 
 void MarkingTracker::Update(const Ipm& ipm, const FrameRecord& frame,
                             std::vector<MarkingObservation>* observations,
-                            std::optional<double> offset_across_m) {
+                            std::optional<double> offset_across_m,
+                            const RoadPlane* road_ahead_map) {
   OrientAlongRoad(ipm, frame, observations);
 
   Associate(*observations, frame, offset_across_m);
-  RefreshFarOnly(ipm.camera(), ipm.T_base_cam(), /*include_retired=*/false);
+  RefreshFarOnly(ipm.camera(), ipm.T_base_cam(), /*include_retired=*/false, road_ahead_map);
   CheckConsistency(ipm, frame);
   MergeDuplicates(ipm);
 }
@@ -287,13 +288,16 @@ void MarkingTracker::CheckConsistency(const Ipm& ipm, const FrameRecord& frame) 
     if (m.far_only && !seen && center_base.head<2>().norm() <= near_range_m && in_image()) {
       ++m.near_frames_expected;
     }
-    if (m.confirmed) continue;
+    // A far-only element stays on probation after its confirmation: it goes once it is seen in
+    // fewer than half the frames that should have seen it (DropSpurious). Retired while its
+    // estimate is still on the way into near view, it is judged by these frames.
+    if (m.confirmed && !m.far_only) continue;
     // Where a view saw it already or nearer, with its center in the image: it should be seen.
     const bool expected = center_base.head<2>().norm() <= m.farthest_view_m && in_image();
     if (!seen && !expected) continue;
     ++m.frames_expected;
     if (seen) ++m.frames_seen;
-    if (m.frames_seen >= kMinSeenToConfirm &&
+    if (!m.confirmed && m.frames_seen >= kMinSeenToConfirm &&
         static_cast<double>(m.frames_seen) >= kMinSeenFraction * m.frames_expected) {
       m.confirmed = true;
       store_->Touch(&m);
@@ -404,13 +408,14 @@ void MarkingTracker::MergeDuplicates(const Ipm& ipm) {
 }
 
 void MarkingTracker::RefreshFarOnly(const PinholeCamera& camera,
-                                    const Eigen::Isometry3d& T_base_cam, bool include_retired) {
+                                    const Eigen::Isometry3d& T_base_cam, bool include_retired,
+                                    const RoadPlane* road_ahead_map) {
   // Moves below this (m) are not changes of the exported map.
   constexpr double kMinMoveM = 1e-3;
   const auto refresh = [&](MarkingElement* m) {
     if (!m->far_only) return false;
     const std::optional<std::array<Eigen::Vector3d, 4>> corners =
-        FarOnlyEstimate(camera, T_base_cam, options_.ipm.error_model, *store_, *m);
+        FarOnlyEstimate(camera, T_base_cam, options_.ipm.error_model, *store_, *m, road_ahead_map);
     if (!corners) return false;
     double moved = 0.0;
     for (int c = 0; c < 4; ++c) moved = std::max(moved, ((*corners)[c] - m->corners_map[c]).norm());
@@ -447,14 +452,17 @@ void MarkingTracker::DropSpurious(std::size_t frame_index) {
                                 }),
                  markings.end());
   counters_->markings_inconsistent += consistent_before - markings.size();
-  // A far-only element that near views did not find where it came into their view: its far
-  // views put it elsewhere than the marking's near views did (a duplicate of it), or nowhere
-  // real. Confirmed or not, it goes.
+  // A far-only element that near views did not find where it came into their view (its far
+  // views put it elsewhere than the marking's near views did: a duplicate of it, or nowhere
+  // real), or that stopped being seen where it should be: confirmed or not, it goes.
   const std::size_t far_before = markings.size();
   markings.erase(std::remove_if(markings.begin(), markings.end(),
                                 [&](const MarkingElement& e) {
                                   return e.far_only &&
-                                         e.near_frames_expected >= kMinExpectedToJudge;
+                                         (e.near_frames_expected >= kMinExpectedToJudge ||
+                                          (e.frames_expected >= kMinExpectedToJudge &&
+                                           static_cast<double>(e.frames_seen) <
+                                               kMinSeenFraction * e.frames_expected));
                                 }),
                  markings.end());
   counters_->far_markings_dropped += far_before - markings.size();

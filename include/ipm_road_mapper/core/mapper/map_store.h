@@ -109,6 +109,8 @@ class MapStore {
   // The road's plane at p_map from the frames that drove within the radius
   // (RoadSurfaceNear's rule, through the frame index).
   RoadSurfaceEstimate RoadSurfaceAt(const Eigen::Vector3d& p_map) const;
+  // The radius of RoadSurfaceAt: a point farther from every frame gets an extrapolated plane.
+  double road_plane_radius_m() const { return road_plane_radius_m_; }
 
   // A lane farther than this from a point does not give it the road's direction.
   static constexpr double kRoadDirectionMaxDistanceM = 8.0;

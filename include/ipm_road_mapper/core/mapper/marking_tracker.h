@@ -28,9 +28,12 @@ class MarkingTracker {
   // `offset_across_m`: the frame's pose error across its heading as the lanes measure it
   // (LaneTracker::OffsetAcross), for association in the registered frame
   // (frame_registration.h).
+  // `road_ahead_map`: the road ahead from the trajectory, for the far-only markings no pose
+  // has passed yet (FarOnlyEstimate); none: the newest pose's plane.
   void Update(const Ipm& ipm, const FrameRecord& frame,
               std::vector<MarkingObservation>* observations,
-              std::optional<double> offset_across_m = std::nullopt);
+              std::optional<double> offset_across_m = std::nullopt,
+              const RoadPlane* road_ahead_map = nullptr);
   // Drops the elements seen in one frame only and not again for
   // association.spurious_after_frames frames, and the tentative ones that frames where they
   // should have been visible did not see (CheckConsistency).
@@ -39,7 +42,7 @@ class MarkingTracker {
   // poses as they are now: the live ones, and the retired ones too when include_retired
   // (the end of the drive, after the final solve moved the poses).
   void RefreshFarOnly(const PinholeCamera& camera, const Eigen::Isometry3d& T_base_cam,
-                      bool include_retired);
+                      bool include_retired, const RoadPlane* road_ahead_map = nullptr);
 
  private:
   // Re-fits each observation's rectangle with sides along the road (the tangent of the
