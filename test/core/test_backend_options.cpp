@@ -140,6 +140,16 @@ TEST(BackendOptions, DumpListsTheKernelAndTheGates) {
   EXPECT_NE(dump.find("backend.max_outside_image_px: 100\n"), std::string::npos) << dump;
 }
 
+TEST(BackendOptions, RetiredInformationForgetsByDefault) {
+  // A plain sum of the retired markings' information held the windows' lever arm wherever it
+  // had wandered (10 km drive: lane APE 0.103 m; docs/backend.md, "The 10 km drive's lever
+  // arm"): the default prior is a marginal of the recent markings.
+  const BackendOptions defaults;
+  EXPECT_GT(defaults.extrinsic_prior_memory_markings, 1.0);
+  EXPECT_EQ(LoadFrom("{}").extrinsic_prior_memory_markings,
+            defaults.extrinsic_prior_memory_markings);
+}
+
 TEST(BackendOptions, ShippedMapperYamlKeepsTheDefaults) {
   const YAML::Node backend = YAML::LoadFile(kMapperYaml)["backend"];
   ASSERT_TRUE(backend.IsMap());

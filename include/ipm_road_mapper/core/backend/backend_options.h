@@ -72,7 +72,10 @@ struct BackendOptions {
   bool extrinsic_hold_unobserved = false;
   // Memory of the retired markings' information in the extrinsic prior, in markings: each
   // retiring marking scales what is there by 1 - 1 / N (extrinsic_prior.h); 0: a plain sum.
-  double extrinsic_prior_memory_markings = 0.0;
+  // A plain sum held the windows' lever arm wherever it had wandered: on the 10 km drive its y
+  // walked to -0.09 m (true 0) and the lanes with it (docs/backend.md, "What leaves the
+  // window").
+  double extrinsic_prior_memory_markings = 50.0;
   // The guard against harm: every N-th frame's measurements are left out of the first map
   // step, and a refined extrinsic that explains them worse than the previous one (with the
   // map re-fit to each) by more than extrinsic_holdout_sigmas times the spread of the
