@@ -308,6 +308,35 @@ TEST_F(PsrTest, UsesTheFixedParameterNotTheClosestPoint) {
   EXPECT_NEAR((Residual(q, 0.7, 1.0) - Eigen::VectorXd(s - q)).norm(), 0.0, 1e-12);
 }
 
+// The joint binding: the frame's IPM point carried by its pose.
+TEST_F(PsrTest, JointBindingIsThePointCarriedByThePoseAndPassesTheGradientCheck) {
+  const Eigen::Quaterniond q_map_base =
+      Eigen::Quaterniond(Eigen::AngleAxisd(0.7, Eigen::Vector3d::UnitZ()) *
+                         Eigen::AngleAxisd(0.02, Eigen::Vector3d::UnitX()))
+          .normalized();
+  const Eigen::Vector3d t_map_base(12.0, -3.0, 0.4);
+  const Eigen::Vector3d p_base(9.0, 1.5, -0.02);
+  const Eigen::Vector3d q_map = q_map_base * p_base + t_map_base;
+  const double u = 0.41, sigma_m = 0.2;
+  std::unique_ptr<ceres::CostFunction> joint(PsrJointResidual::Create(p_base, u, sigma_m));
+  const std::vector<const double*> parameters = {
+      c_[0].data(),     c_[1].data(), c_[2].data(), c_[3].data(), q_map_base.coeffs().data(),
+      t_map_base.data()};
+  // The same residual as the build-time point in the map.
+  EXPECT_NEAR((Evaluate(*joint, parameters) - Residual(q_map, u, sigma_m)).norm(), 0.0, 1e-12);
+  // Moving the pose moves the point: 0.1 m of t along y is -0.1 / sigma in r_y.
+  const Eigen::Vector3d t_moved = t_map_base + Eigen::Vector3d(0.0, 0.1, 0.0);
+  const Eigen::VectorXd r_moved =
+      Evaluate(*joint, {c_[0].data(), c_[1].data(), c_[2].data(), c_[3].data(),
+                        q_map_base.coeffs().data(), t_moved.data()});
+  EXPECT_NEAR(r_moved(1) - Residual(q_map, u, sigma_m)(1), -0.1 / sigma_m, 1e-12);
+  // In the quaternion's raw coefficients: in the manifold's tangent (a left rotation) the
+  // Jacobian of R p is -[R p]x / sigma, whose diagonal is zero exactly and which the
+  // numeric differences meet only to 1e-14, not to a relative precision.
+  ExpectJacobiansMatch(*joint, std::vector<const ceres::Manifold*>(6, nullptr), parameters,
+                       kGradientPrecision);
+}
+
 // ---------------------------------------------------------------------------------------
 // Lane smoothness.
 

@@ -112,5 +112,46 @@ TEST(CollectLanePixels, TakesTheViewingFramesFrontEndGround) {
   EXPECT_EQ(state.lane_pixels[0].segment, 11);  // control points 12 and 13: x = 30 and 33 m
 }
 
+TEST(RefreshPsrPoints, ReIpmsThePointWithTheExtrinsicTheSolveRefined) {
+  // A line 25 m ahead seen by a camera pitched 4.3 deg; the window begins with 4.0 deg, which
+  // puts its IPM point about 2.5 m too far. Once the solve has the true pitch, the PSR point
+  // (what PSR measures) must be re-IPMed with it, and go to the segment it falls on.
+  const Eigen::Isometry3d T_base_cam_true =
+      test::MountedCamera(0.0, 4.3 * kDeg, 0.0, Eigen::Vector3d(1.5, 0.0, 1.5));
+  WindowSnapshot snapshot;
+  snapshot.camera = test::Intrinsics1280x720();
+  snapshot.T_base_cam = test::MountedCamera(0.0, 4.0 * kDeg, 0.0, Eigen::Vector3d(1.5, 0.0, 1.5));
+  WindowFrame frame;
+  frame.index = 5;
+  snapshot.frames.push_back(frame);
+  WindowLane lane;
+  for (double x = -6.0; x <= 60.0; x += 3.0) lane.control_points_map.emplace_back(x, 3.5, 0.0);
+  LaneMeasurement measurement;
+  measurement.frame_index = frame.index;
+  LanePoint point;
+  ASSERT_TRUE(
+      PinholeCamera(snapshot.camera)
+          .Project(Eigen::Vector3d(T_base_cam_true.inverse() * Eigen::Vector3d(25.0, 3.5, 0.0)),
+                   &point.uv));
+  measurement.points.push_back(point);
+  measurement.selected.push_back(1);
+  lane.measurements.push_back(measurement);
+  snapshot.lanes.push_back(lane);
+  BackendOptions options;
+  options.lane_residual = LaneResidual::kPsr;
+  window_solve::WindowState state(snapshot);
+  window_solve::CollectLanePixels(snapshot, options, &state);
+  ASSERT_EQ(state.lane_pixels.size(), 1u);
+  EXPECT_GT(state.lane_pixels[0].q_map.x(), 26.0);  // the window's extrinsic: too far
+  state.extrinsic = window_solve::PoseBlocks(T_base_cam_true);
+  window_solve::RefreshPsrPoints(snapshot, options, &state);
+  const window_solve::LanePixel& pixel = state.lane_pixels[0];
+  EXPECT_NEAR(pixel.q_map.x(), 25.0, 1e-6);
+  EXPECT_NEAR(pixel.q_map.y(), 3.5, 1e-6);
+  EXPECT_NEAR((pixel.p_base - pixel.q_map).norm(), 0.0, 1e-9);  // the frame is at the origin
+  EXPECT_EQ(pixel.segment, 9);  // control points 10 and 11: x = 24 and 27 m
+  EXPECT_NEAR(pixel.u, 1.0 / 3.0, 0.02);
+}
+
 }  // namespace
 }  // namespace ipm_road_mapper

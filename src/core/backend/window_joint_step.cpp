@@ -4,7 +4,9 @@
 #include "ipm_road_mapper/core/backend/residuals/edge_reprojection_residual.h"
 #include "ipm_road_mapper/core/backend/residuals/pose_uncertainty.h"
 #include "ipm_road_mapper/core/backend/residuals/ppsr_residual.h"
+#include "ipm_road_mapper/core/backend/residuals/psr_residual.h"
 #include "ipm_road_mapper/core/backend/window_map_step.h"
+#include "ipm_road_mapper/core/backend/window_measurements.h"
 
 namespace ipm_road_mapper {
 namespace window_solve {
@@ -116,6 +118,17 @@ ceres::Solver::Summary JointStep(const WindowSnapshot& snapshot, const BackendOp
       problem.AddResidualBlock(residuals::PpsrResidual::Create(camera, px.uv, sigma_px), loss,
                                cps[px.segment + 1].data(), cps[px.segment + 2].data(), pose.q,
                                pose.t, q_bc, t_bc);
+      ++*blocks;
+    }
+  } else if (options.lane_residual == LaneResidual::kPsr) {
+    RefreshPsrPoints(snapshot, options, state);
+    for (const LanePixel& px : state->lane_pixels) {
+      auto& cps = state->control_points[px.lane];
+      PoseBlocks& pose = state->frames[px.slot];
+      problem.AddResidualBlock(
+          residuals::PsrJointResidual::Create(px.p_base, px.u, options.psr_sigma_m), loss,
+          cps[px.segment].data(), cps[px.segment + 1].data(), cps[px.segment + 2].data(),
+          cps[px.segment + 3].data(), pose.q, pose.t);
       ++*blocks;
     }
   }

@@ -14,6 +14,7 @@
 #include "ipm_road_mapper/core/backend/residuals/psr_residual.h"
 #include "ipm_road_mapper/core/backend/residuals/road_cross_section_prior_residual.h"
 #include "ipm_road_mapper/core/backend/residuals/road_surface_prior_residual.h"
+#include "ipm_road_mapper/core/backend/window_measurements.h"
 #include "ipm_road_mapper/core/geometry/road_surface.h"
 
 namespace ipm_road_mapper {
@@ -206,6 +207,7 @@ ceres::Solver::Summary MapStep(const WindowSnapshot& snapshot, const BackendOpti
                                WindowState* state, int* blocks) {
   ceres::Problem problem;
   ceres::LossFunction* loss = MakeLoss(options);
+  if (options.lane_residual == LaneResidual::kPsr) RefreshPsrPoints(snapshot, options, state);
   *blocks = AddMapStepMeasurements(snapshot, options,
                                    state->hold_out ? Measurements::kTraining : Measurements::kAll,
                                    loss, state, &problem);

@@ -1,6 +1,7 @@
 #include "ipm_road_mapper/core/backend/window_measurements.h"
 
 #include <algorithm>
+#include <optional>
 
 #include "ipm_road_mapper/core/frontend/marking_measurement.h"
 #include "ipm_road_mapper/core/geometry/catmull_rom_spline.h"
@@ -187,10 +188,41 @@ void CollectLanePixels(const WindowSnapshot& snapshot, const BackendOptions& opt
                                options.max_outside_image_px)) {
           continue;
         }
-        state->lane_pixels.push_back(
-            {l, slot->second, point.uv, closest.segment, closest.u, p_map});
+        state->lane_pixels.push_back({l, slot->second, point.uv, closest.segment, closest.u, p_map,
+                                      T_map_base.inverse() * p_map});
       }
     }
+  }
+}
+
+void RefreshPsrPoints(const WindowSnapshot& snapshot, const BackendOptions& options,
+                      WindowState* state) {
+  const PinholeCamera camera(snapshot.camera);
+  const Eigen::Isometry3d T_base_cam = state->extrinsic.ToIsometry();
+  std::vector<std::optional<CatmullRomSpline>> splines(snapshot.lanes.size());
+  for (LanePixel& px : state->lane_pixels) {
+    const auto& cps = state->control_points[px.lane];
+    if (cps.size() < 4) continue;
+    if (!splines[px.lane]) splines[px.lane].emplace(cps);
+    const CatmullRomSpline& spline = *splines[px.lane];
+    const Eigen::Isometry3d T_map_base = state->frames[px.slot].ToIsometry();
+    const Eigen::Isometry3d T_map_cam = T_map_base * T_base_cam;
+    Eigen::Vector3d p_map;
+    if (!OntoFrameGround(camera, T_map_cam, T_map_base, snapshot.frames[px.slot].ground_base, px.uv,
+                         &p_map)) {
+      continue;
+    }
+    CatmullRomSpline::ClosestPoint closest = spline.FindClosest(p_map);
+    if (options.lane_pixels_on_lane_surface &&
+        !OntoLaneSurface(camera, T_map_cam, T_map_base, px.uv, spline, &p_map, &closest)) {
+      continue;
+    }
+    // Past an end the old assignment stands (the segments are those the pixel was given).
+    if (closest.s <= 0.0 || closest.s >= spline.NumSegments()) continue;
+    px.segment = closest.segment;
+    px.u = closest.u;
+    px.q_map = p_map;
+    px.p_base = T_map_base.inverse() * p_map;
   }
 }
 

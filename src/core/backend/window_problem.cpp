@@ -71,10 +71,9 @@ WindowResult SolveWindow(const WindowSnapshot& snapshot, const BackendOptions& o
     if (usable && options.pose_update) run(false);
   }
   // The joint step (final global solve): down the valley the alternation crawls along. Its
-  // lanes are PPSR pixels with the poses free. PSR (the ablation) has no joint form, and a
-  // step that moved the poses without its lanes would leave them behind: skipped. Without a
-  // lane residual the lanes follow the poses at export anyway.
-  if (snapshot.joint_step_iterations > 0 && options.lane_residual != LaneResidual::kPsr && usable) {
+  // lanes are PPSR pixels, or PSR points carried by their frames' poses, with the poses
+  // free. Without a lane residual the lanes follow the poses at export anyway.
+  if (snapshot.joint_step_iterations > 0 && usable) {
     state.step_time_limit_s = remaining_s();
     if (state.step_time_limit_s > 0.0) {
       BackendOptions joint = options;

@@ -18,5 +18,12 @@ void CollectCornerMeasurements(const WindowSnapshot& snapshot, const BackendOpti
 void CollectLanePixels(const WindowSnapshot& snapshot, const BackendOptions& options,
                        WindowState* state);
 
+// PSR (the ablation) only: each lane pixel's IPM point again, from the state's current poses
+// and extrinsic, and its closest point on the state's current spline. The 3D point is what
+// PSR measures, so it follows the extrinsic the solve refines (PPSR's pixels see it
+// directly); without this, lanes kept the extrinsic their window began with.
+void RefreshPsrPoints(const WindowSnapshot& snapshot, const BackendOptions& options,
+                      WindowState* state);
+
 }  // namespace window_solve
 }  // namespace ipm_road_mapper

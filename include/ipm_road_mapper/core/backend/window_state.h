@@ -65,7 +65,8 @@ struct LanePixel {
   Eigen::Vector2d uv;
   int segment = 0;
   double u = 0.0;
-  Eigen::Vector3d q_map;  // IPM point at build time (PSR)
+  Eigen::Vector3d q_map;   // IPM point at build time (PSR)
+  Eigen::Vector3d p_base;  // the same point in its frame's base_link (PSR, joint step)
 };
 
 // The mutable state of one solve, initialized from the snapshot, and the measurements that
