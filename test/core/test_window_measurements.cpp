@@ -55,6 +55,29 @@ WindowSnapshot CrestSnapshot(const std::vector<double>& x_on_lane_m) {
   return snapshot;
 }
 
+// A straight level lane 3.5 m left of one frame (a camera mounted pitched 4 deg) and one pixel of
+// it: the point x_m ahead seen by the camera at T_map_base * T_base_cam_seen.
+WindowSnapshot FlatLaneSnapshot(const WindowFrame& frame, const Eigen::Isometry3d& T_base_cam_seen,
+                                double x_m) {
+  WindowSnapshot snapshot;
+  snapshot.camera = test::Intrinsics1280x720();
+  snapshot.T_base_cam = test::MountedCamera(0.0, 4.0 * kDeg, 0.0, Eigen::Vector3d(1.5, 0.0, 1.5));
+  snapshot.frames.push_back(frame);
+  WindowLane lane;
+  for (double x = -6.0; x <= 60.0; x += 3.0) lane.control_points_map.emplace_back(x, 3.5, 0.0);
+  LaneMeasurement measurement;
+  measurement.frame_index = frame.index;
+  LanePoint point;
+  const Eigen::Isometry3d T_cam_map = (frame.T_map_base * T_base_cam_seen).inverse();
+  EXPECT_TRUE(PinholeCamera(snapshot.camera)
+                  .Project(Eigen::Vector3d(T_cam_map * Eigen::Vector3d(x_m, 3.5, 0.0)), &point.uv));
+  measurement.points.push_back(point);
+  measurement.selected.push_back(1);
+  lane.measurements.push_back(measurement);
+  snapshot.lanes.push_back(lane);
+  return snapshot;
+}
+
 TEST(CollectLanePixels, AssignsAPixelBeyondACrestToTheSegmentItsRayMeets) {
   const std::vector<double> x_true = {12.0, 16.5, 25.0, 31.0};
   const WindowSnapshot snapshot = CrestSnapshot(x_true);
@@ -82,27 +105,12 @@ TEST(CollectLanePixels, TakesTheViewingFramesFrontEndGround) {
   // One frame, pitched 0.3 deg nose down on flat ground, its front end's ground the road
   // (level): a pixel of a line 31 m ahead goes onto that ground, not onto the pitched plane
   // of base_link, which puts it 2 m farther.
-  WindowSnapshot snapshot;
-  snapshot.camera = test::Intrinsics1280x720();
-  snapshot.T_base_cam = test::MountedCamera(0.0, 4.0 * kDeg, 0.0, Eigen::Vector3d(1.5, 0.0, 1.5));
   WindowFrame frame;
   frame.index = 3;
   frame.T_map_base.linear() = RotationFromRpy(0.0, 0.3 * kDeg, 0.0);
   frame.ground_base.normal = frame.T_map_base.linear().transpose() * Eigen::Vector3d::UnitZ();
-  snapshot.frames.push_back(frame);
-  WindowLane lane;
-  for (double x = -6.0; x <= 60.0; x += 3.0) lane.control_points_map.emplace_back(x, 3.5, 0.0);
-  LaneMeasurement measurement;
-  measurement.frame_index = frame.index;
-  LanePoint point;
-  const Eigen::Isometry3d T_cam_map = (frame.T_map_base * snapshot.T_base_cam).inverse();
-  ASSERT_TRUE(
-      PinholeCamera(snapshot.camera)
-          .Project(Eigen::Vector3d(T_cam_map * Eigen::Vector3d(31.0, 3.5, 0.0)), &point.uv));
-  measurement.points.push_back(point);
-  measurement.selected.push_back(1);
-  lane.measurements.push_back(measurement);
-  snapshot.lanes.push_back(lane);
+  const WindowSnapshot snapshot = FlatLaneSnapshot(
+      frame, test::MountedCamera(0.0, 4.0 * kDeg, 0.0, Eigen::Vector3d(1.5, 0.0, 1.5)), 31.0);
   BackendOptions options;
   window_solve::WindowState state(snapshot);
   window_solve::CollectLanePixels(snapshot, options, &state);
@@ -118,25 +126,9 @@ TEST(RefreshPsrPoints, ReIpmsThePointWithTheExtrinsicTheSolveRefined) {
   // (what PSR measures) must be re-IPMed with it, and go to the segment it falls on.
   const Eigen::Isometry3d T_base_cam_true =
       test::MountedCamera(0.0, 4.3 * kDeg, 0.0, Eigen::Vector3d(1.5, 0.0, 1.5));
-  WindowSnapshot snapshot;
-  snapshot.camera = test::Intrinsics1280x720();
-  snapshot.T_base_cam = test::MountedCamera(0.0, 4.0 * kDeg, 0.0, Eigen::Vector3d(1.5, 0.0, 1.5));
   WindowFrame frame;
   frame.index = 5;
-  snapshot.frames.push_back(frame);
-  WindowLane lane;
-  for (double x = -6.0; x <= 60.0; x += 3.0) lane.control_points_map.emplace_back(x, 3.5, 0.0);
-  LaneMeasurement measurement;
-  measurement.frame_index = frame.index;
-  LanePoint point;
-  ASSERT_TRUE(
-      PinholeCamera(snapshot.camera)
-          .Project(Eigen::Vector3d(T_base_cam_true.inverse() * Eigen::Vector3d(25.0, 3.5, 0.0)),
-                   &point.uv));
-  measurement.points.push_back(point);
-  measurement.selected.push_back(1);
-  lane.measurements.push_back(measurement);
-  snapshot.lanes.push_back(lane);
+  const WindowSnapshot snapshot = FlatLaneSnapshot(frame, T_base_cam_true, 25.0);
   BackendOptions options;
   options.lane_residual = LaneResidual::kPsr;
   window_solve::WindowState state(snapshot);

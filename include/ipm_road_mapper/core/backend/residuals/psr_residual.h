@@ -26,6 +26,17 @@
 namespace ipm_road_mapper {
 namespace residuals {
 
+// The residual, shared by the bindings below: (S(c0, c1, c2, c3; u) - q) * inv_sigma.
+template <typename T>
+void Psr(const T* const c0, const T* const c1, const T* const c2, const T* const c3, double u,
+         const Eigen::Matrix<T, 3, 1>& q, double inv_sigma, T* residual) {
+  using V = Eigen::Matrix<T, 3, 1>;
+  const V s =
+      CatmullRomSpline::EvaluateSegment<T>(V(c0[0], c0[1], c0[2]), V(c1[0], c1[1], c1[2]),
+                                           V(c2[0], c2[1], c2[2]), V(c3[0], c3[1], c3[2]), T(u));
+  for (int i = 0; i < 3; ++i) residual[i] = (s(i) - q(i)) * T(inv_sigma);
+}
+
 class PsrResidual {
  public:
   PsrResidual(const Eigen::Vector3d& q_map, double u, double sigma_m)
@@ -34,11 +45,7 @@ class PsrResidual {
   template <typename T>
   bool operator()(const T* const c0, const T* const c1, const T* const c2, const T* const c3,
                   T* residual) const {
-    using V = Eigen::Matrix<T, 3, 1>;
-    const V s =
-        CatmullRomSpline::EvaluateSegment<T>(V(c0[0], c0[1], c0[2]), V(c1[0], c1[1], c1[2]),
-                                             V(c2[0], c2[1], c2[2]), V(c3[0], c3[1], c3[2]), T(u_));
-    for (int i = 0; i < 3; ++i) residual[i] = (s(i) - T(q_map_(i))) * T(inv_sigma_);
+    Psr(c0, c1, c2, c3, u_, Eigen::Matrix<T, 3, 1>(q_map_.cast<T>()), inv_sigma_, residual);
     return true;
   }
 
@@ -65,11 +72,7 @@ class PsrJointResidual {
     using V = Eigen::Matrix<T, 3, 1>;
     const Eigen::Map<const Eigen::Quaternion<T>> q_mb(q_map_base);
     const Eigen::Map<const V> t_mb(t_map_base);
-    const V q = q_mb * p_base_.cast<T>() + t_mb;
-    const V s =
-        CatmullRomSpline::EvaluateSegment<T>(V(c0[0], c0[1], c0[2]), V(c1[0], c1[1], c1[2]),
-                                             V(c2[0], c2[1], c2[2]), V(c3[0], c3[1], c3[2]), T(u_));
-    for (int i = 0; i < 3; ++i) residual[i] = (s(i) - q(i)) * T(inv_sigma_);
+    Psr(c0, c1, c2, c3, u_, V(q_mb * p_base_.cast<T>() + t_mb), inv_sigma_, residual);
     return true;
   }
 
