@@ -1,8 +1,10 @@
 // The map store: its road-surface query is RoadSurfaceNear's over every frame (through the
-// index, also after pose corrections), the road direction comes from the nearest lane, and
-// clearing keeps element ids unique.
+// index, also after pose corrections; beyond the radius, the frames around the closest one),
+// the road direction comes from the nearest lane, and clearing keeps element ids unique.
 #include <gtest/gtest.h>
 
+#include <algorithm>
+#include <cmath>
 #include <random>
 
 #include "ipm_road_mapper/core/geometry/rigid_transform.h"
@@ -35,17 +37,53 @@ TEST(MapStore, RoadSurfaceIsRoadSurfaceNearOverAllFrames) {
     poses[i].translation() += Eigen::Vector3d(lateral(rng), lateral(rng), 0.0);
     store.SetFramePose(i, poses[i]);
   }
+  int aside = 0;
   for (int q = 0; q < 100; ++q) {
     const Eigen::Vector3d p(2.5 * q - 20.0, lateral(rng) * 10.0, 0.0);
-    const RoadSurfaceEstimate expected = RoadSurfaceNear(poses, p, 4.0);
+    RoadSurfaceEstimate expected = RoadSurfaceNear(poses, p, 4.0);
     const RoadSurfaceEstimate got = store.RoadSurfaceAt(p);
-    EXPECT_EQ(got.frames, expected.frames);
     EXPECT_DOUBLE_EQ(got.distance_m, expected.distance_m);
+    if (expected.distance_m > 4.0) {
+      // No frame within the radius: the frames around the closest one.
+      std::size_t closest = 0;
+      for (std::size_t i = 0; i < poses.size(); ++i) {
+        if ((poses[i].translation() - p).head<2>().norm() <
+            (poses[closest].translation() - p).head<2>().norm()) {
+          closest = i;
+        }
+      }
+      expected = RoadSurfaceNear(poses, poses[closest].translation(), 4.0);
+      ++aside;
+    }
+    EXPECT_EQ(got.frames, expected.frames);
     EXPECT_TRUE(got.plane.point.isApprox(expected.plane.point, 1e-12));
     EXPECT_TRUE(got.plane.normal.isApprox(expected.plane.normal, 1e-12));
   }
+  EXPECT_GT(aside, 5);  // the fallback was exercised
   EXPECT_EQ(store.frames()[7].T_map_base.translation(), poses[7].translation());
   EXPECT_EQ(store.frames()[7].T_map_base_odom.translation().x(), 3.5 * std::cos(0.0105));
+}
+
+TEST(MapStore, RoadSurfaceAsideOfEveryFrameIsTheRoadNotOneInstantOfTheBodysPitch) {
+  // A level road driven at 7 m/s (20 Hz), the body pitching 0.3 deg at 1.1 Hz on it, at the
+  // top of a swing in the last frame; a point 8 m aside of that frame, beyond the 6 m radius
+  // of every frame. The last frame's own plane is pitched 0.3 deg (13 cm at 25 m along); the
+  // frames around it average the swing out.
+  constexpr double kDeg = M_PI / 180.0;
+  constexpr int kFrames = 200;
+  const double t_last = 0.05 * (kFrames - 1);
+  MapStore store(6.0);
+  for (int i = 0; i < kFrames; ++i) {
+    const double t = 0.05 * i;
+    const double pitch = 0.3 * kDeg * std::cos(2.0 * M_PI * 1.1 * (t - t_last));
+    store.AddFrame(t, Pose(7.0 * t, 0.0, 0.0, 0.0, pitch, 0.0));
+  }
+  const Eigen::Vector3d aside(7.0 * t_last, 8.0, 0.0);
+  const RoadSurfaceEstimate road = store.RoadSurfaceAt(aside);
+  EXPECT_NEAR(road.distance_m, 8.0, 1e-9);
+  EXPECT_GT(road.frames, 10);
+  const double tilt_deg = std::acos(std::min(1.0, road.plane.normal.z())) / kDeg;
+  EXPECT_LT(tilt_deg, 0.1);  // the last frame alone: 0.3 deg
 }
 
 TEST(MapStore, RoadDirectionIsTheNearestLanesTangent) {

@@ -310,9 +310,13 @@ RoadSurfaceEstimate MapStore::RoadSurfaceAt(const Eigen::Vector3d& p_map) const 
   double closest_distance_m = 0.0;
   if (!frame_index_.Nearest(p_map, &closest, &closest_distance_m)) return RoadSurfaceEstimate();
   std::vector<const Eigen::Isometry3d*> within;
-  for (std::size_t i : frame_index_.Within(p_map, road_plane_radius_m_)) {
-    within.push_back(&map_.frames[i].T_map_base);
+  std::vector<std::size_t> indices = frame_index_.Within(p_map, road_plane_radius_m_);
+  if (indices.empty()) {
+    // Aside or ahead of every pose: the road around the closest one (map_store.h).
+    indices =
+        frame_index_.Within(map_.frames[closest].T_map_base.translation(), road_plane_radius_m_);
   }
+  for (std::size_t i : indices) within.push_back(&map_.frames[i].T_map_base);
   return RoadSurfaceFromPoses(within, map_.frames[closest].T_map_base, closest_distance_m, p_map);
 }
 
