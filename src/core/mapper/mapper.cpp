@@ -198,6 +198,11 @@ bool Mapper::Finish(double time_budget_s) {
     // The far-only markings on the final poses and extrinsic.
     markings_.RefreshFarOnly(PinholeCamera(windows_.camera()), windows_.T_base_cam(),
                              /*include_retired=*/true);
+    // The unmeasured sides of partially seen markings, on the road from the final poses (a
+    // back-end step: plain IPM, the paper's front end alone, keeps its flat-ground extents).
+    if (windows_.enabled()) {
+      markings_.RemeasurePartialExtents(PinholeCamera(windows_.camera()), windows_.T_base_cam());
+    }
   }
   lanes_.JoinFragments();  // fragments the drive's last frames left apart
   store_.NoteRemovals();

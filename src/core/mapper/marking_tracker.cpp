@@ -11,6 +11,7 @@
 #include "ipm_road_mapper/core/mapper/far_marking_estimate.h"
 #include "ipm_road_mapper/core/mapper/marking_extent.h"
 #include "ipm_road_mapper/core/mapper/marking_pixel_agreement.h"
+#include "ipm_road_mapper/core/mapper/partial_extent_on_road.h"
 #include "ipm_road_mapper/core/mapper/shared_frames.h"
 
 namespace ipm_road_mapper {
@@ -428,6 +429,27 @@ void MarkingTracker::RefreshFarOnly(const PinholeCamera& camera,
   if (!include_retired) return;
   bool moved = false;
   for (MarkingElement& m : store_->retired_markings()) moved = refresh(&m) || moved;
+  if (moved) store_->ReindexRetiredMarkings();
+}
+
+void MarkingTracker::RemeasurePartialExtents(const PinholeCamera& camera,
+                                             const Eigen::Isometry3d& T_base_cam) {
+  // Moves below this (m) are not changes of the exported map.
+  constexpr double kMinMoveM = 1e-3;
+  const auto remeasure = [&](MarkingElement* m) {
+    const std::optional<std::array<Eigen::Vector3d, 4>> corners =
+        PartialExtentOnRoad(camera, T_base_cam, *store_, *m);
+    if (!corners) return false;
+    double moved = 0.0;
+    for (int c = 0; c < 4; ++c) moved = std::max(moved, ((*corners)[c] - m->corners_map[c]).norm());
+    if (moved < kMinMoveM) return false;
+    m->corners_map = *corners;
+    store_->Touch(m);
+    return true;
+  };
+  for (MarkingElement& m : store_->markings()) remeasure(&m);
+  bool moved = false;
+  for (MarkingElement& m : store_->retired_markings()) moved = remeasure(&m) || moved;
   if (moved) store_->ReindexRetiredMarkings();
 }
 

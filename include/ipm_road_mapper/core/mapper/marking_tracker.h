@@ -43,6 +43,10 @@ class MarkingTracker {
   // (the end of the drive, after the final solve moved the poses).
   void RefreshFarOnly(const PinholeCamera& camera, const Eigen::Isometry3d& T_base_cam,
                       bool include_retired, const RoadPlane* road_ahead_map = nullptr);
+  // The end of the drive, after the final solve: the unmeasured sides of every element seen
+  // only in partial views (live and retired), measured again on the road plane from the
+  // corrected poses (PartialExtentOnRoad).
+  void RemeasurePartialExtents(const PinholeCamera& camera, const Eigen::Isometry3d& T_base_cam);
 
  private:
   // Re-fits each observation's rectangle with sides along the road (the tangent of the
