@@ -1,6 +1,7 @@
 // The road surface from the vehicle's poses: averaging the frames near a point removes the
 // body's pitch oscillation; a point no frame has passed gets the closest frame's plane and
-// its distance. And the pose-uncertainty whitening of the map step's residuals.
+// its distance. A pixel's ray onto a plane. And the pose-uncertainty whitening of the map
+// step's residuals.
 #include <gtest/gtest.h>
 
 #include <cmath>
@@ -88,6 +89,24 @@ TEST(PoseUncertaintyWhitening, IsThePixelSigmaForExactPosesAndWeakerOtherwise) {
   EXPECT_LT(info_near, 0.5 * 0.25);  // at least halved from 1 / 2^2
   EXPECT_GT(info_far, info_near);
   EXPECT_LE(info_far, 0.25 + 1e-12);
+}
+
+TEST(PixelOntoPlane, MeetsThePlaneAheadAndNeverAboveTheHorizonOrBehind) {
+  const PinholeCamera camera(test::Intrinsics1280x720());
+  const Eigen::Isometry3d T_map_cam =
+      test::MountedCamera(0.0, 4.0 * kDeg, 0.0, Eigen::Vector3d(1.5, 0.0, 1.5));
+  const RoadPlane road{Eigen::Vector3d::Zero(), Eigen::Vector3d::UnitZ()};
+  const Eigen::Vector3d ahead(20.0, 2.0, 0.0);
+  Eigen::Vector2d uv;
+  ASSERT_TRUE(camera.Project(Eigen::Vector3d(T_map_cam.inverse() * ahead), &uv));
+  Eigen::Vector3d p_map;
+  ASSERT_TRUE(PixelOntoPlane(camera, T_map_cam, road, uv, &p_map));
+  EXPECT_LT((p_map - ahead).norm(), 1e-9);
+  // A pixel above the horizon, a plane above the camera (met behind it), a NaN pixel.
+  EXPECT_FALSE(PixelOntoPlane(camera, T_map_cam, road, Eigen::Vector2d(640.0, 0.0), &p_map));
+  const RoadPlane above{Eigen::Vector3d(0.0, 0.0, 3.0), Eigen::Vector3d::UnitZ()};
+  EXPECT_FALSE(PixelOntoPlane(camera, T_map_cam, above, uv, &p_map));
+  EXPECT_FALSE(PixelOntoPlane(camera, T_map_cam, road, Eigen::Vector2d::Constant(NAN), &p_map));
 }
 
 }  // namespace

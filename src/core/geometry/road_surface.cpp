@@ -2,6 +2,8 @@
 
 #include <limits>
 
+#include "ipm_road_mapper/core/geometry/ipm.h"
+
 namespace ipm_road_mapper {
 
 RoadSurfaceEstimate RoadSurfaceNear(const std::vector<Eigen::Isometry3d>& T_map_base,
@@ -44,6 +46,19 @@ RoadSurfaceEstimate RoadSurfaceFromPoses(const std::vector<const Eigen::Isometry
   estimate.plane.normal = normal_sum.normalized();
   if (estimate.plane.normal.z() < 0.0) estimate.plane.normal = -estimate.plane.normal;
   return estimate;
+}
+
+bool PixelOntoPlane(const PinholeCamera& camera, const Eigen::Isometry3d& T_map_cam,
+                    const RoadPlane& plane, const Eigen::Vector2d& uv, Eigen::Vector3d* p_map) {
+  if (!uv.allFinite()) return false;
+  const Eigen::Vector2d xy = camera.UndistortToNormalized(uv);
+  const Eigen::Vector3d ray_map = T_map_cam.linear() * Eigen::Vector3d(xy.x(), xy.y(), 1.0);
+  const double descent = plane.normal.dot(ray_map);
+  if (!(descent < -Ipm::kMinRayDescent * ray_map.norm())) return false;
+  const double lambda = plane.normal.dot(plane.point - T_map_cam.translation()) / descent;
+  if (!(lambda > 0.0)) return false;
+  *p_map = T_map_cam.translation() + lambda * ray_map;
+  return true;
 }
 
 }  // namespace ipm_road_mapper

@@ -8,20 +8,6 @@
 namespace ipm_road_mapper {
 namespace {
 
-// The ray of pixel uv from the camera at T_map_cam meets the plane ahead: *p_map.
-bool OntoPlane(const PinholeCamera& camera, const Eigen::Isometry3d& T_map_cam,
-               const RoadPlane& plane, const Eigen::Vector2d& uv, Eigen::Vector3d* p_map) {
-  if (!uv.allFinite()) return false;
-  const Eigen::Vector2d xy = camera.UndistortToNormalized(uv);
-  const Eigen::Vector3d ray_map = T_map_cam.linear() * Eigen::Vector3d(xy.x(), xy.y(), 1.0);
-  const double descent = plane.normal.dot(ray_map);
-  if (!(descent < -Ipm::kMinRayDescent * ray_map.norm())) return false;
-  const double lambda = plane.normal.dot(plane.point - T_map_cam.translation()) / descent;
-  if (!(lambda > 0.0)) return false;
-  *p_map = T_map_cam.translation() + lambda * ray_map;
-  return true;
-}
-
 // Passes over the views: the plane is looked up at the old center, then at the new one.
 constexpr int kPlaneLookups = 2;
 
@@ -58,7 +44,7 @@ std::optional<std::array<Eigen::Vector3d, 4>> FarOnlyEstimate(const PinholeCamer
       std::array<Eigen::Vector3d, 4> view;
       bool maps = true;
       for (int c = 0; c < 4 && maps; ++c)
-        maps = OntoPlane(camera, T_map_cam, plane, corners_uv[c], &view[c]);
+        maps = PixelOntoPlane(camera, T_map_cam, plane, corners_uv[c], &view[c]);
       if (!maps) continue;
       const Eigen::Vector2d center_uv =
           0.25 * (corners_uv[0] + corners_uv[1] + corners_uv[2] + corners_uv[3]);

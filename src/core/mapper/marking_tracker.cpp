@@ -408,15 +408,11 @@ void MarkingTracker::MergeDuplicates(const Ipm& ipm) {
   }
 }
 
-void MarkingTracker::RefreshFarOnly(const PinholeCamera& camera,
-                                    const Eigen::Isometry3d& T_base_cam, bool include_retired,
-                                    const RoadPlane* road_ahead_map) {
+void MarkingTracker::ReestimateCorners(const CornerEstimate& estimate, bool include_retired) {
   // Moves below this (m) are not changes of the exported map.
   constexpr double kMinMoveM = 1e-3;
-  const auto refresh = [&](MarkingElement* m) {
-    if (!m->far_only) return false;
-    const std::optional<std::array<Eigen::Vector3d, 4>> corners =
-        FarOnlyEstimate(camera, T_base_cam, options_.ipm.error_model, *store_, *m, road_ahead_map);
+  const auto update = [&](MarkingElement* m) {
+    const std::optional<std::array<Eigen::Vector3d, 4>> corners = estimate(*m);
     if (!corners) return false;
     double moved = 0.0;
     for (int c = 0; c < 4; ++c) moved = std::max(moved, ((*corners)[c] - m->corners_map[c]).norm());
@@ -425,32 +421,30 @@ void MarkingTracker::RefreshFarOnly(const PinholeCamera& camera,
     store_->Touch(m);
     return true;
   };
-  for (MarkingElement& m : store_->markings()) refresh(&m);
+  for (MarkingElement& m : store_->markings()) update(&m);
   if (!include_retired) return;
   bool moved = false;
-  for (MarkingElement& m : store_->retired_markings()) moved = refresh(&m) || moved;
+  for (MarkingElement& m : store_->retired_markings()) moved = update(&m) || moved;
   if (moved) store_->ReindexRetiredMarkings();
+}
+
+void MarkingTracker::RefreshFarOnly(const PinholeCamera& camera,
+                                    const Eigen::Isometry3d& T_base_cam, bool include_retired,
+                                    const RoadPlane* road_ahead_map) {
+  ReestimateCorners(
+      [&](const MarkingElement& m) -> std::optional<std::array<Eigen::Vector3d, 4>> {
+        if (!m.far_only) return std::nullopt;
+        return FarOnlyEstimate(camera, T_base_cam, options_.ipm.error_model, *store_, m,
+                               road_ahead_map);
+      },
+      include_retired);
 }
 
 void MarkingTracker::RemeasurePartialExtents(const PinholeCamera& camera,
                                              const Eigen::Isometry3d& T_base_cam) {
-  // Moves below this (m) are not changes of the exported map.
-  constexpr double kMinMoveM = 1e-3;
-  const auto remeasure = [&](MarkingElement* m) {
-    const std::optional<std::array<Eigen::Vector3d, 4>> corners =
-        PartialExtentOnRoad(camera, T_base_cam, *store_, *m);
-    if (!corners) return false;
-    double moved = 0.0;
-    for (int c = 0; c < 4; ++c) moved = std::max(moved, ((*corners)[c] - m->corners_map[c]).norm());
-    if (moved < kMinMoveM) return false;
-    m->corners_map = *corners;
-    store_->Touch(m);
-    return true;
-  };
-  for (MarkingElement& m : store_->markings()) remeasure(&m);
-  bool moved = false;
-  for (MarkingElement& m : store_->retired_markings()) moved = remeasure(&m) || moved;
-  if (moved) store_->ReindexRetiredMarkings();
+  ReestimateCorners(
+      [&](const MarkingElement& m) { return PartialExtentOnRoad(camera, T_base_cam, *store_, m); },
+      /*include_retired=*/true);
 }
 
 void MarkingTracker::DropSpurious(std::size_t frame_index) {

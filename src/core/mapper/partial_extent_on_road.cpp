@@ -3,7 +3,7 @@
 #include <cmath>
 #include <limits>
 
-#include "ipm_road_mapper/core/geometry/ipm.h"
+#include "ipm_road_mapper/core/geometry/road_surface.h"
 
 namespace ipm_road_mapper {
 
@@ -12,10 +12,8 @@ std::optional<std::array<Eigen::Vector3d, 4>> PartialExtentOnRoad(
     const MarkingElement& element) {
   if (element.Complete() || element.far_only || element.pruned > 0) return std::nullopt;
   const Eigen::Vector3d center = element.Center();
-  const RoadPlane plane = store.RoadSurfaceAt(center).plane;
-  if (!(plane.normal.norm() > 0.0)) return std::nullopt;
-  const Eigen::Vector3d up = plane.normal.normalized() * (plane.normal.z() < 0.0 ? -1.0 : 1.0);
-  // Outward normals of the unmeasured sides (x-y), and the union of the views along each.
+  const RoadPlane plane = store.RoadSurfaceAt(center).plane;  // normal up (road_surface.h)
+  // Outward normals of the sides (x-y), and the union of the views along each.
   std::array<Eigen::Vector2d, 4> normal;
   std::array<double, 4> reach;
   reach.fill(-std::numeric_limits<double>::infinity());
@@ -35,15 +33,10 @@ std::optional<std::array<Eigen::Vector3d, 4>> PartialExtentOnRoad(
     view_reach.fill(-std::numeric_limits<double>::infinity());
     bool maps = true;
     for (const Eigen::Vector2d& uv : meas.outline_uv) {
-      const Eigen::Vector2d xy = camera.UndistortToNormalized(uv);
-      const Eigen::Vector3d ray = T_map_cam.linear() * Eigen::Vector3d(xy.x(), xy.y(), 1.0);
-      const double descent = up.dot(ray);
-      if (!(descent < -Ipm::kMinRayDescent * ray.norm())) {
-        maps = false;
-        break;
-      }
-      const double t = up.dot(plane.point - T_map_cam.translation()) / descent;
-      const Eigen::Vector2d p = (T_map_cam.translation() + t * ray).head<2>() - center.head<2>();
+      Eigen::Vector3d p_map;
+      maps = PixelOntoPlane(camera, T_map_cam, plane, uv, &p_map);
+      if (!maps) break;
+      const Eigen::Vector2d p = p_map.head<2>() - center.head<2>();
       for (int s = 0; s < 4; ++s) view_reach[s] = std::max(view_reach[s], normal[s].dot(p));
     }
     if (!maps) continue;

@@ -9,6 +9,8 @@
 #include <Eigen/Geometry>
 #include <vector>
 
+#include "ipm_road_mapper/core/geometry/pinhole_camera.h"
+
 namespace ipm_road_mapper {
 
 // A plane in the map frame: n . (p - point) = 0, n of unit length, pointing up.
@@ -35,5 +37,11 @@ RoadSurfaceEstimate RoadSurfaceNear(const std::vector<Eigen::Isometry3d>& T_map_
 RoadSurfaceEstimate RoadSurfaceFromPoses(const std::vector<const Eigen::Isometry3d*>& within,
                                          const Eigen::Isometry3d& T_map_base_closest,
                                          double closest_distance_m, const Eigen::Vector3d& p_map);
+
+// Where the ray of pixel uv from the camera at T_map_cam meets `plane` (normal up) ahead of the
+// camera: *p_map. False for a non-finite pixel, a ray that does not descend to the plane (at
+// or above its horizon) or one that meets it behind the camera.
+bool PixelOntoPlane(const PinholeCamera& camera, const Eigen::Isometry3d& T_map_cam,
+                    const RoadPlane& plane, const Eigen::Vector2d& uv, Eigen::Vector3d* p_map);
 
 }  // namespace ipm_road_mapper

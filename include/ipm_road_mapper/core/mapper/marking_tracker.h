@@ -6,6 +6,7 @@
 #pragma once
 
 #include <cstddef>
+#include <functional>
 #include <optional>
 #include <vector>
 
@@ -49,6 +50,13 @@ class MarkingTracker {
   void RemeasurePartialExtents(const PinholeCamera& camera, const Eigen::Isometry3d& T_base_cam);
 
  private:
+  // New corners of an element, or none to keep its own.
+  using CornerEstimate =
+      std::function<std::optional<std::array<Eigen::Vector3d, 4>>(const MarkingElement&)>;
+  // Replaces each live element's corners (and each retired one's when include_retired) by
+  // `estimate`'s where they moved by 1 mm or more: touched for the export, the retired index
+  // rebuilt when one of those moved.
+  void ReestimateCorners(const CornerEstimate& estimate, bool include_retired);
   // Re-fits each observation's rectangle with sides along the road (the tangent of the
   // nearest mapped lane): the ground truth's rectangles follow the road, and the vehicle's
   // heading is 5 deg off it on a 150 m curve 15 m ahead.
