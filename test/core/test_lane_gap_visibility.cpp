@@ -1,7 +1,8 @@
 // Whether frames saw the gap between two lane fragments (lane_gap_visibility.h): a gap on
 // the road ahead of a forward camera is seen, the same gap behind the camera, beside it
-// beyond the range or with no camera known is not (or counts as seen), and the frames looked
-// at are those between the fragments plus the look-around travel.
+// beyond the range or with no camera known is not (or counts as seen), a sliver of it shorter
+// than a line the tracker would map is not, and the frames looked at are those between the
+// fragments plus the look-around travel.
 #include <gtest/gtest.h>
 
 #include <cmath>
@@ -65,6 +66,50 @@ TEST(LaneGapVisibility, AGapBehindBesideOrBeyondTheRangeIsNotSeen) {
   strict.max_point_score_m2 = 1e-4;
   EXPECT_EQ(FramesThatSawGap(GapPoints(30.0, 40.0), FramesAlongX(0.0, 5), {0, 5}, camera, strict),
             0u);
+}
+
+TEST(LaneGapVisibility, ASliverOfTheGapIsNotSeeingIt) {
+  // urban's inner line of the turn: one frame had 1 m of the gap in the image's corner, at the
+  // edge of the usable range; a line there would have started no lane (min_new_lane_length_m).
+  const std::vector<FrameRecord> frames = FramesAlongX(0.0, 1);
+  GapViewOptions three_m;
+  three_m.min_seen_length_m = 3.0;
+  const std::vector<Eigen::Vector3d> sliver = GapPoints(10.0, 11.0);
+  EXPECT_EQ(FramesThatSawGap(sliver, frames, {0, 1}, ForwardCamera(), GapViewOptions()), 1u);
+  EXPECT_EQ(FramesThatSawGap(sliver, frames, {0, 1}, ForwardCamera(), three_m), 0u);
+  // A long one, given by two points out of view (behind the camera and 60 m ahead): its
+  // samples between are seen over more than 3 m.
+  const std::vector<Eigen::Vector3d> long_gap{{-10.0, 1.75, 0.0}, {60.0, 1.75, 0.0}};
+  EXPECT_EQ(FramesThatSawGap(long_gap, frames, {0, 1}, ForwardCamera(), three_m), 1u);
+}
+
+TEST(LaneGapVisibility, AGapJustInsideTheImagesEdgeIsSeenOnlyIfItsLineCertainlyWas) {
+  // The line 10-14 m ahead, 0.2 m inside the image's left edge (found by projecting): in view
+  // as given, but not when it may lie 0.5 m to either side (a bridge between two ends whose
+  // offsets from the path disagree: urban seeds 2 and 4, where the line was outside the view).
+  const GapCamera camera = ForwardCamera();
+  const std::vector<FrameRecord> frames = FramesAlongX(0.0, 1);
+  const Eigen::Isometry3d T_cam_base = camera.T_base_cam.inverse();
+  double y_edge = 0.0;
+  for (double y = 0.0; y < 30.0; y += 0.01) {
+    Eigen::Vector2d uv;
+    if (!camera.camera.Project(T_cam_base * Eigen::Vector3d(10.0, y, 0.0), &uv) ||
+        !camera.camera.InImage(uv, 0.0)) {
+      break;
+    }
+    y_edge = y;
+  }
+  ASSERT_GT(y_edge, 1.0);
+  // Parallel to the left edge's ray through (10, y_edge), 0.2 m to its right.
+  std::vector<Eigen::Vector3d> gap;
+  for (double x = 10.0; x <= 14.0; x += 0.5) gap.emplace_back(x, (y_edge - 0.2) * x / 10.0, 0.0);
+  GapViewOptions options;
+  options.min_seen_length_m = 3.0;
+  EXPECT_EQ(FramesThatSawGap(gap, frames, {0, 1}, camera, options), 1u);
+  options.lateral_uncertainty_m = 0.5;
+  EXPECT_EQ(FramesThatSawGap(gap, frames, {0, 1}, camera, options), 0u);
+  // Well inside the image, the same uncertainty leaves it seen.
+  EXPECT_EQ(FramesThatSawGap(GapPoints(10.0, 14.0), frames, {0, 1}, camera, options), 1u);
 }
 
 TEST(LaneGapVisibility, WithoutACameraEveryGapCountsAsSeen) {

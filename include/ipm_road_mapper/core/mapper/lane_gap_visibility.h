@@ -5,7 +5,10 @@
 // same line, 30 m on), so only the frames can tell them apart: a gap longer than
 // lanes.join_max_gap_m is bridged only when no frame had a point of it in the image at a
 // pixel whose IPM uncertainty would have made it a usable lane point
-// (LaneTracker::JoinFragments, docs/backend.md "Joining fragments").
+// (LaneTracker::JoinFragments, docs/backend.md "Joining fragments"), and only when it had
+// as much of the gap there as the tracker needs of a line to map it from one frame
+// (lanes.min_new_lane_length_m): a sliver of the gap in a corner of one image is no sign the
+// line is absent.
 #pragma once
 
 #include <Eigen/Geometry>
@@ -25,6 +28,14 @@ struct GapViewOptions {
   double max_point_score_m2 = 1.0;
   double max_range_m = 40.0;      // ipm.max_range_m: farther ground points are rejected
   double border_margin_px = 0.0;  // extraction.border_margin_px
+  // A frame saw the gap when the part of it it had in view (as above) spans at least this
+  // (lanes.min_new_lane_length_m: a shorter piece of a line starts no lane); 0: any point.
+  double min_seen_length_m = 0.0;
+  // How far across the gap the line may lie from the given points (the bridge's lateral
+  // uncertainty): a point counts as in view only when it is in view displaced this far to
+  // either side as well. Near the image's edge a bridge 0.5 m inside a line that lies just
+  // outside the view is "in view" while the line is not (urban seeds 2 and 4).
+  double lateral_uncertainty_m = 0.0;
   // At most this many frames are checked, evenly strided (a standstill's frames are alike).
   std::size_t max_frames = 400;
 };
@@ -46,9 +57,14 @@ struct FrameSpan {
 FrameSpan GapFrameSpan(const std::vector<FrameRecord>& frames, std::size_t first_last_frame,
                        std::size_t second_first_frame, double lookaround_m);
 
-// How many frames of `span` had a point of `gap_points_map` in view (in front of the camera,
-// in the image at least border_margin_px inside, within max_range_m of base_link, Omega_p
-// score at most max_point_score_m2), with the frames' corrected poses.
+// How many frames of `span` had a stretch of at least min_seen_length_m of the polyline
+// `gap_points_map` (sampled every kGapSampleSpacingM) in view: in front of the camera, in the
+// image at least border_margin_px inside (also when moved lateral_uncertainty_m across the
+// polyline either way), within max_range_m of base_link, Omega_p score at most
+// max_point_score_m2; with the frames' corrected poses. A stretch's length is the
+// largest distance of a seen sample from the first seen one, as the tracker measures a new
+// line's (its seen samples need not be contiguous: an occluder may cut a seen line).
+constexpr double kGapSampleSpacingM = 0.5;
 std::size_t FramesThatSawGap(const std::vector<Eigen::Vector3d>& gap_points_map,
                              const std::vector<FrameRecord>& frames, const FrameSpan& span,
                              const GapCamera& camera, const GapViewOptions& options);
