@@ -340,13 +340,20 @@ std::optional<LaneElement> JoinLanes(const LaneElement& first, const LaneElement
 }
 
 std::optional<LaneElement> JoinLanesThrough(const LaneElement& first, const LaneElement& second,
-                                            const std::vector<Eigen::Vector3d>& bridge_map) {
+                                            const std::vector<Eigen::Vector3d>& bridge_map,
+                                            std::size_t first_end_dropped,
+                                            std::size_t second_start_dropped) {
   const std::vector<Eigen::Vector3d>& cf = first.control_points_map;
   const std::vector<Eigen::Vector3d>& cs = second.control_points_map;
-  if (cf.size() < 4 || cs.size() < 4) return std::nullopt;
-  std::vector<Eigen::Vector3d> cps(cf.begin(), cf.end() - 1);  // without first's end phantom
+  if (cf.size() < 4 + first_end_dropped || cs.size() < 4 + second_start_dropped) {
+    return std::nullopt;
+  }
+  // Without first's end phantom and dropped points, without second's start phantom and dropped.
+  const auto first_to = cf.end() - 1 - static_cast<std::ptrdiff_t>(first_end_dropped);
+  const auto second_from = cs.begin() + 1 + static_cast<std::ptrdiff_t>(second_start_dropped);
+  std::vector<Eigen::Vector3d> cps(cf.begin(), first_to);
   cps.insert(cps.end(), bridge_map.begin(), bridge_map.end());
-  cps.insert(cps.end(), cs.begin() + 1, cs.end() - 1);  // without second's start phantom
+  cps.insert(cps.end(), second_from, cs.end() - 1);
   cps.push_back(2.0 * cps.back() - cps[cps.size() - 2]);
   return Joined(first, second, std::move(cps));
 }

@@ -59,7 +59,10 @@ void LaneTracker::JoinFragments(std::size_t settled_before_frame) {
     if (best_hidden) {
       const std::optional<PathBridge> bridge =
           HiddenGapBridge(lanes[best_a], lanes[best_b], GapSpan(lanes[best_a], lanes[best_b]));
-      if (bridge) result = JoinLanesThrough(lanes[best_a], lanes[best_b], bridge->points);
+      if (bridge) {
+        result = JoinLanesThrough(lanes[best_a], lanes[best_b], bridge->points,
+                                  bridge->first_end_dropped, bridge->second_start_dropped);
+      }
     } else {
       result = JoinLanes(lanes[best_a], lanes[best_b], join, options_.association,
                          options_.lanes.fit.chord_spacing_m);
@@ -102,7 +105,12 @@ double LaneTracker::JoinCost(const LaneElement& first, const LaneElement& second
   view.max_point_score_m2 = options_.association.lane_max_point_score_m2;
   view.max_range_m = options_.ipm.max_range_m;
   view.border_margin_px = options_.extraction.border_margin_px;
-  if (FramesThatSawGap(bridge->points, store_->frames(), span, gap_camera_, view) > 0) return -1.0;
+  view.min_seen_length_m = options_.lanes.min_new_lane_length_m;
+  // The bridge lies between the two ends' offsets, each known to about the floor sigma.
+  view.lateral_uncertainty_m = sigma + 0.5 * std::abs(bridge->offset_change_m);
+  if (FramesThatSawGap(bridge->unseen_points, store_->frames(), span, gap_camera_, view) > 0) {
+    return -1.0;
+  }
   *hidden = true;
   return path_cost;
 }
@@ -117,7 +125,9 @@ std::optional<PathBridge> LaneTracker::HiddenGapBridge(const LaneElement& first,
                                                        const FrameSpan& span) const {
   const double spacing_m = options_.lanes.fit.chord_spacing_m;
   return BridgeAlongPath(first, second, store_->frames(), span,
-                         options_.lanes.join.max_hidden_gap_m, spacing_m, spacing_m);
+                         options_.lanes.join.max_hidden_gap_m, spacing_m, spacing_m,
+                         options_.lanes.join.end_length_m,
+                         options_.lanes.join.gate_sigmas * LaneFloorSigma(options_.association));
 }
 
 }  // namespace ipm_road_mapper

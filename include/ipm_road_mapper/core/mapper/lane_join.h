@@ -59,10 +59,13 @@ std::optional<LaneElement> JoinLanes(const LaneElement& first, const LaneElement
                                      double chord_spacing_m);
 
 // `first` and `second` joined through `bridge_map` (points from first's end to second's
-// start, e.g. BridgeAlongPath): first's control points, the bridge, second's; the rest as
-// JoinLanes. Nullopt when either lane has fewer than 4 control points.
+// start, e.g. BridgeAlongPath): first's control points but its last `first_end_dropped` real
+// ones, the bridge, second's but its first `second_start_dropped`; the rest as JoinLanes.
+// Nullopt when either lane would keep fewer than 2 real control points.
 std::optional<LaneElement> JoinLanesThrough(const LaneElement& first, const LaneElement& second,
-                                            const std::vector<Eigen::Vector3d>& bridge_map);
+                                            const std::vector<Eigen::Vector3d>& bridge_map,
+                                            std::size_t first_end_dropped = 0,
+                                            std::size_t second_start_dropped = 0);
 
 // Horizontal direction of a lane at its end (at_end) or start, pointing along the lane,
 // from its last (first) interior control point to the one about `length_m` before (after)
