@@ -132,6 +132,40 @@ TEST(LaneJoin, HalvesOfADoubleLineStayApart) {
   }
 }
 
+TEST(LaneJoin, ALineWhoseInstanceAnOccluderSplitIsJoined) {
+  std::mt19937 rng(5);
+  // One line; over frames 30-39 a vehicle on it splits its instance in two: the near piece
+  // continues lane a, the far one, 4 m on past the vehicle, starts lane b.
+  const LaneElement a = MakeLane(1, 2, Straight(0.0), 0.0, 40.0, 0, 40, &rng);
+  LaneElement b = MakeLane(2, 2, Straight(0.0), 44.0, 80.0, 40, 80, &rng);
+  std::vector<LaneMeasurement> split;
+  for (const LaneMeasurement& m : a.history) {
+    if (m.frame_index < 30) continue;
+    LaneMeasurement far = m;
+    for (Eigen::Vector3d& p : far.selected_map) p.x() += 7.0;  // beyond the vehicle
+    split.push_back(far);
+  }
+  b.history.insert(b.history.begin(), split.begin(), split.end());
+  b.first_frame = 30;
+  // Seen in one frame, but end to end: one line.
+  EXPECT_FALSE(CoObserved(a, b));
+  EXPECT_TRUE(LaneContinues(a, b, LaneJoinOptions(), AssociationOptions()));
+  // The same two instances side by side (a double line's halves 0.3 m apart) stay apart.
+  LaneElement beside = b;
+  for (std::size_t k = 0; k < split.size(); ++k) {
+    for (Eigen::Vector3d& p : beside.history[k].selected_map) p += Eigen::Vector3d(-7.0, -0.3, 0.0);
+  }
+  EXPECT_TRUE(CoObserved(a, beside));
+  EXPECT_FALSE(LaneContinues(a, beside, LaneJoinOptions(), AssociationOptions()));
+  // End to end but on the next lane's line, 3.5 m across (short pieces: av2_pit_dev's
+  // solid lines, where the union of the two pieces' points is widest across): two lines.
+  LaneElement staggered = b;
+  for (std::size_t k = 0; k < split.size(); ++k) {
+    for (Eigen::Vector3d& p : staggered.history[k].selected_map) p.y() += 3.5;
+  }
+  EXPECT_TRUE(CoObserved(a, staggered));
+}
+
 TEST(LaneJoin, ALineThatEndsIsNotContinuedByAnotherLine) {
   std::mt19937 rng(4);
   const LaneElement ends = MakeLane(1, 2, Straight(0.0), 0.0, 40.0, 0, 40, &rng);

@@ -1,12 +1,14 @@
 #include "ipm_road_mapper/core/mapper/lane_join.h"
 
 #include <Eigen/Cholesky>
+#include <Eigen/Eigenvalues>
 #include <algorithm>
 #include <cmath>
 #include <limits>
+#include <optional>
+#include <tuple>
 
 #include "ipm_road_mapper/core/geometry/catmull_rom_spline.h"
-#include "ipm_road_mapper/core/mapper/shared_frames.h"
 
 namespace ipm_road_mapper {
 namespace {
@@ -273,7 +275,71 @@ void MergeObservations(const LaneElement& other, LaneElement* lane) {
   lane->last_seen = std::max(lane->last_seen, other.last_seen);
 }
 
-bool CoObserved(const LaneElement& a, const LaneElement& b) { return SeenInOneFrame(a, b); }
+namespace {
+
+// The horizontal principal direction of `set` (unit), or nullopt when it has no extent.
+std::optional<Eigen::Vector2d> PrincipalDirection(const std::vector<Eigen::Vector3d>& set) {
+  if (set.size() < 2) return std::nullopt;
+  Eigen::Vector2d mean = Eigen::Vector2d::Zero();
+  for (const Eigen::Vector3d& p : set) mean += p.head<2>();
+  mean /= static_cast<double>(set.size());
+  Eigen::Matrix2d scatter = Eigen::Matrix2d::Zero();
+  for (const Eigen::Vector3d& p : set) {
+    const Eigen::Vector2d d = p.head<2>() - mean;
+    scatter += d * d.transpose();
+  }
+  const Eigen::SelfAdjointEigenSolver<Eigen::Matrix2d> solver(scatter);
+  if (!(solver.eigenvalues()(1) > 0.0)) return std::nullopt;
+  return Eigen::Vector2d(solver.eigenvectors().col(1));  // the larger eigenvalue's
+}
+
+// Whether two instances of one frame are two lines: side by side (overlapping along their
+// common direction by more than kSideBySideOverlapM) or not on one line (their means more
+// than kCollinearOffsetM apart across it: staggered lines, a lane shift). The direction is
+// the mean of each set's own principal direction (the union's would be across two short
+// pieces of parallel lines). Either without extent: two lines (nothing tells them apart).
+bool TwoLinesInOneFrame(const std::vector<Eigen::Vector3d>& a,
+                        const std::vector<Eigen::Vector3d>& b) {
+  const auto da = PrincipalDirection(a);
+  auto db = PrincipalDirection(b);
+  if (!da || !db) return true;
+  if (da->dot(*db) < 0.0) *db = -*db;
+  const Eigen::Vector2d along = (*da + *db).normalized();
+  const Eigen::Vector2d across(-along.y(), along.x());
+  const auto extent = [&](const std::vector<Eigen::Vector3d>& set) {
+    double lo = std::numeric_limits<double>::infinity(), hi = -lo, mean_across = 0.0;
+    for (const Eigen::Vector3d& p : set) {
+      lo = std::min(lo, p.head<2>().dot(along));
+      hi = std::max(hi, p.head<2>().dot(along));
+      mean_across += p.head<2>().dot(across);
+    }
+    return std::make_tuple(lo, hi, mean_across / static_cast<double>(set.size()));
+  };
+  const auto [a_lo, a_hi, a_across] = extent(a);
+  const auto [b_lo, b_hi, b_across] = extent(b);
+  const double overlap = std::min(a_hi, b_hi) - std::max(a_lo, b_lo);
+  return overlap > kSideBySideOverlapM || std::abs(b_across - a_across) > kCollinearOffsetM;
+}
+
+}  // namespace
+
+bool CoObserved(const LaneElement& a, const LaneElement& b) {
+  // A merge walk over the two histories (sorted by frame), each shared frame's points compared.
+  auto i = a.history.begin();
+  auto j = b.history.begin();
+  while (i != a.history.end() && j != b.history.end()) {
+    if (i->frame_index == j->frame_index) {
+      if (TwoLinesInOneFrame(i->selected_map, j->selected_map)) return true;
+      ++i;
+      ++j;
+    } else if (i->frame_index < j->frame_index) {
+      ++i;
+    } else {
+      ++j;
+    }
+  }
+  return false;
+}
 
 bool LaneContinues(const LaneElement& first, const LaneElement& second, const LaneJoinOptions& join,
                    const AssociationOptions& options) {

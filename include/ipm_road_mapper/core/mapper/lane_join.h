@@ -6,8 +6,9 @@
 // lateral IPM uncertainty (Omega_p, correlated over consecutive frames). The two models are
 // compared where the gap is (its middle): the lateral offset and the direction must agree
 // within their combined uncertainty (the extrapolation over the gap is in it), the gap must
-// be short, the class the same, and the two never seen in one frame (two instances of one
-// frame are two lines: the double line's halves 0.2-0.5 m apart stay apart).
+// be short, the class the same, and the two never seen side by side in one frame (two
+// instances of one frame side by side are two lines: the double line's halves 0.2-0.5 m
+// apart stay apart; end to end they are one line an occluder split, CoObserved).
 #pragma once
 
 #include <optional>
@@ -77,7 +78,14 @@ Eigen::Vector2d LaneEndDirection(const std::vector<Eigen::Vector3d>& control_poi
 // stamp spans (a merge or a join; control points are the caller's).
 void MergeObservations(const LaneElement& other, LaneElement* lane);
 
-// Whether the two lanes have a measurement of one frame each (histories sorted by frame).
+// Whether the two lanes were seen as two lines in one frame: a frame with a measurement of
+// each (histories sorted by frame) whose selected points overlap along the line (the mean of
+// the two sets' principal directions) by more than kSideBySideOverlapM, or whose means lie
+// more than kCollinearOffsetM apart across it, or either without extent. Two instances of
+// one frame side by side are two lines (a double line's halves), as are two staggered ones;
+// end to end on one line they are one line whose instance an occluder split (a vehicle on it).
+constexpr double kSideBySideOverlapM = 0.5;
+constexpr double kCollinearOffsetM = 0.5;
 bool CoObserved(const LaneElement& a, const LaneElement& b);
 
 }  // namespace ipm_road_mapper
