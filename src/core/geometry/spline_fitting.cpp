@@ -1,11 +1,12 @@
 #include "ipm_road_mapper/core/geometry/spline_fitting.h"
 
-#include <Eigen/Eigenvalues>
 #include <Eigen/SparseCholesky>
 #include <algorithm>
 #include <cmath>
 #include <limits>
 #include <stdexcept>
+
+#include "ipm_road_mapper/core/geometry/principal_axis.h"
 
 namespace ipm_road_mapper {
 namespace {
@@ -71,16 +72,9 @@ double ProjectOnPolyline(const std::vector<Eigen::Vector3d>& nodes, const std::v
 // Initial curve coordinate: projection on the principal axis of the points in x-y, with the
 // axis oriented to positive x (positive y when x is 0).
 std::vector<double> PrincipalAxisCoordinates(const std::vector<Eigen::Vector3d>& points) {
-  Eigen::Vector2d mean = Eigen::Vector2d::Zero();
-  for (const Eigen::Vector3d& p : points) mean += p.head<2>();
-  mean /= static_cast<double>(points.size());
-  Eigen::Matrix2d covariance = Eigen::Matrix2d::Zero();
-  for (const Eigen::Vector3d& p : points) {
-    const Eigen::Vector2d d = p.head<2>() - mean;
-    covariance += d * d.transpose();
-  }
-  Eigen::SelfAdjointEigenSolver<Eigen::Matrix2d> solver(covariance);
-  Eigen::Vector2d axis = solver.eigenvectors().col(1);  // largest eigenvalue
+  const PrincipalAxis principal = HorizontalPrincipalAxis(points);
+  const Eigen::Vector2d& mean = principal.mean;
+  Eigen::Vector2d axis = principal.direction;
   if (axis.x() < 0.0 || (axis.x() == 0.0 && axis.y() < 0.0)) axis = -axis;
   std::vector<double> t;
   t.reserve(points.size());

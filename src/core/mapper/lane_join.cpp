@@ -1,14 +1,13 @@
 #include "ipm_road_mapper/core/mapper/lane_join.h"
 
 #include <Eigen/Cholesky>
-#include <Eigen/Eigenvalues>
 #include <algorithm>
 #include <cmath>
 #include <limits>
-#include <optional>
 #include <tuple>
 
 #include "ipm_road_mapper/core/geometry/catmull_rom_spline.h"
+#include "ipm_road_mapper/core/geometry/principal_axis.h"
 
 namespace ipm_road_mapper {
 namespace {
@@ -277,22 +276,6 @@ void MergeObservations(const LaneElement& other, LaneElement* lane) {
 
 namespace {
 
-// The horizontal principal direction of `set` (unit), or nullopt when it has no extent.
-std::optional<Eigen::Vector2d> PrincipalDirection(const std::vector<Eigen::Vector3d>& set) {
-  if (set.size() < 2) return std::nullopt;
-  Eigen::Vector2d mean = Eigen::Vector2d::Zero();
-  for (const Eigen::Vector3d& p : set) mean += p.head<2>();
-  mean /= static_cast<double>(set.size());
-  Eigen::Matrix2d scatter = Eigen::Matrix2d::Zero();
-  for (const Eigen::Vector3d& p : set) {
-    const Eigen::Vector2d d = p.head<2>() - mean;
-    scatter += d * d.transpose();
-  }
-  const Eigen::SelfAdjointEigenSolver<Eigen::Matrix2d> solver(scatter);
-  if (!(solver.eigenvalues()(1) > 0.0)) return std::nullopt;
-  return Eigen::Vector2d(solver.eigenvectors().col(1));  // the larger eigenvalue's
-}
-
 // Whether two instances of one frame are two lines: side by side (overlapping along their
 // common direction by more than kSideBySideOverlapM) or not on one line (their means more
 // than kCollinearOffsetM apart across it: staggered lines, a lane shift). The direction is
@@ -300,11 +283,11 @@ std::optional<Eigen::Vector2d> PrincipalDirection(const std::vector<Eigen::Vecto
 // pieces of parallel lines). Either without extent: two lines (nothing tells them apart).
 bool TwoLinesInOneFrame(const std::vector<Eigen::Vector3d>& a,
                         const std::vector<Eigen::Vector3d>& b) {
-  const auto da = PrincipalDirection(a);
-  auto db = PrincipalDirection(b);
-  if (!da || !db) return true;
-  if (da->dot(*db) < 0.0) *db = -*db;
-  const Eigen::Vector2d along = (*da + *db).normalized();
+  const PrincipalAxis pa = HorizontalPrincipalAxis(a), pb = HorizontalPrincipalAxis(b);
+  if (!(pa.scatter > 0.0) || !(pb.scatter > 0.0)) return true;
+  const Eigen::Vector2d& da = pa.direction;
+  const Eigen::Vector2d db = pa.direction.dot(pb.direction) < 0.0 ? -pb.direction : pb.direction;
+  const Eigen::Vector2d along = (da + db).normalized();
   const Eigen::Vector2d across(-along.y(), along.x());
   const auto extent = [&](const std::vector<Eigen::Vector3d>& set) {
     double lo = std::numeric_limits<double>::infinity(), hi = -lo, mean_across = 0.0;
