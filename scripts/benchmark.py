@@ -19,6 +19,7 @@ Figures are measured here and printed; nothing is asserted (tests assert loose b
 """
 import argparse
 import concurrent.futures
+import fcntl
 import hashlib
 import json
 import math
@@ -236,6 +237,16 @@ def main():
     out_root = args.out or os.path.join(args.repo, "out", "benchmark")
     if args.instructions and not args.long:
         parser.error("--instructions goes with --long")
+    # Two runs on one output folder regenerate and read the same cached drives at once (a bag
+    # written by one while the other writes it too is corrupt): one at a time.
+    os.makedirs(out_root, exist_ok=True)
+    lock = open(os.path.join(out_root, ".lock"), "w")
+    try:
+        fcntl.flock(lock, fcntl.LOCK_EX | fcntl.LOCK_NB)
+    except OSError:
+        print("benchmark: error: another benchmark run is using %s (wait for it, or pass "
+              "--out <another folder>)" % out_root, file=sys.stderr)
+        sys.exit(2)
     if args.long:
         import benchmark_long
         return benchmark_long.main(args, out_root)
