@@ -57,6 +57,9 @@ struct FrameSpan {
 FrameSpan GapFrameSpan(const std::vector<FrameRecord>& frames, std::size_t first_last_frame,
                        std::size_t second_first_frame, double lookaround_m);
 
+// The spacing at which FramesThatSawGap samples the gap's polyline.
+constexpr double kGapSampleSpacingM = 0.5;
+
 // How many frames of `span` had a stretch of at least min_seen_length_m of the polyline
 // `gap_points_map` (sampled every kGapSampleSpacingM) in view: in front of the camera, in the
 // image at least border_margin_px inside (also when moved lateral_uncertainty_m across the
@@ -64,7 +67,6 @@ FrameSpan GapFrameSpan(const std::vector<FrameRecord>& frames, std::size_t first
 // max_point_score_m2; with the frames' corrected poses. A stretch's length is the
 // largest distance of a seen sample from the first seen one, as the tracker measures a new
 // line's (its seen samples need not be contiguous: an occluder may cut a seen line).
-constexpr double kGapSampleSpacingM = 0.5;
 std::size_t FramesThatSawGap(const std::vector<Eigen::Vector3d>& gap_points_map,
                              const std::vector<FrameRecord>& frames, const FrameSpan& span,
                              const GapCamera& camera, const GapViewOptions& options);
