@@ -82,6 +82,7 @@ inline VectorMap MakeMap() {
   for (int k = 0; k < 6; ++k) {
     lane.control_points_map.emplace_back(3.0 * k - 3.0, 1.75 + 0.01 * k * k, 0.001 * k);
   }
+  lane.unmeasured = {{2, 3}};  // laid by a join across a gap in its observations
   lane.observations = 40;
   map.lanes.push_back(lane);
   map.T_base_cam = MakePose(1.5, 0.02, 1.4, -M_PI / 2 - 0.01, 0.003, -M_PI / 2 + 0.02);

@@ -39,6 +39,7 @@ void ExpectMapsEqual(const VectorMap& a, const VectorMap& b) {
     EXPECT_EQ(a.lanes[i].id, b.lanes[i].id);
     EXPECT_EQ(a.lanes[i].style, b.lanes[i].style);
     EXPECT_EQ(a.lanes[i].class_name, b.lanes[i].class_name);
+    EXPECT_EQ(a.lanes[i].unmeasured, b.lanes[i].unmeasured);
     ASSERT_EQ(a.lanes[i].control_points_map.size(), b.lanes[i].control_points_map.size());
     for (std::size_t k = 0; k < a.lanes[i].control_points_map.size(); ++k) {
       EXPECT_LT((a.lanes[i].control_points_map[k] - b.lanes[i].control_points_map[k]).norm(), 1e-9);
@@ -112,6 +113,26 @@ TEST_F(MapIoTest, MarkingSideFlagsAreWrittenAndOptionalOnRead) {
   EXPECT_THROW(VectorMapFromJson(bad), MapFormatError);
 }
 
+TEST_F(MapIoTest, LaneUnmeasuredRangesAreWrittenCheckedAndOptionalOnRead) {
+  const nlohmann::json j = VectorMapToJson(MakeMap());
+  EXPECT_EQ(j["lanes"][0]["unmeasured"], nlohmann::json::parse("[[2, 3]]"));
+  // A map written before the ranges existed: every control point measured.
+  nlohmann::json old = j;
+  old["lanes"][0].erase("unmeasured");
+  EXPECT_TRUE(VectorMapFromJson(old).lanes[0].unmeasured.empty());
+  // Ranges outside the lane's 6 points, reversed, overlapping or malformed are refused.
+  for (const char* bad_ranges : {"[[2, 6]]", "[[3, 2]]", "[[1, 3], [3, 4]]", "[[4, 5], [1, 2]]",
+                                 "[[1]]", "[[-1, 2]]", "[2, 3]", "{}"}) {
+    nlohmann::json bad = j;
+    bad["lanes"][0]["unmeasured"] = nlohmann::json::parse(bad_ranges);
+    EXPECT_THROW(VectorMapFromJson(bad), MapFormatError) << bad_ranges;
+  }
+  nlohmann::json two = j;
+  two["lanes"][0]["unmeasured"] = nlohmann::json::parse("[[0, 1], [3, 5]]");
+  EXPECT_EQ(VectorMapFromJson(two).lanes[0].unmeasured,
+            (std::vector<std::pair<std::size_t, std::size_t>>{{0, 1}, {3, 5}}));
+}
+
 TEST_F(MapIoTest, SaveRefusesNaNAndKeepsTheOldFile) {
   const VectorMap good = MakeMap();
   SaveVectorMapJson(good, Path("map.json"));
@@ -167,6 +188,8 @@ TEST_F(MapIoTest, BadMapFilesThrowOneLineErrors) {
                     "trajectory[1].stamp");
   ExpectMapRejected(path, mutated([](auto& j) { j["markings"][1]["id"] = 7; }), "duplicate id");
   ExpectMapRejected(path, mutated([](auto& j) { j["lanes"][0]["id"] = -1; }), "lanes[0].id");
+  ExpectMapRejected(path, mutated([](auto& j) { j["lanes"][0]["unmeasured"][0][1] = 9; }),
+                    "lanes[0].unmeasured[0]: expected first <= last < 6");
   // A bare NaN literal is not JSON at all.
   std::string with_nan = good;
   with_nan.replace(with_nan.find("10.1"), 4, "NaN");

@@ -42,11 +42,14 @@ nlohmann::json LaneToJson(const MapLane& lane) {
   for (const Eigen::Vector3d& c : lane.control_points_map) {
     points.push_back(json_io::Vector3ToJson(c));
   }
+  nlohmann::json unmeasured = nlohmann::json::array();
+  for (const auto& [first, last] : lane.unmeasured) unmeasured.push_back({first, last});
   return {{"id", lane.id},
           {"class_id", lane.class_id},
           {"class_name", lane.class_name},
           {"style", lane.style},
           {"control_points", points},
+          {"unmeasured", unmeasured},
           {"observations", lane.observations},
           {"first_seen", lane.first_seen},
           {"last_seen", lane.last_seen},
@@ -65,6 +68,33 @@ std::vector<std::uint64_t> OptionalIds(const nlohmann::json& j, const char* key,
     ids.push_back(json_io::ReadUint64(array[k], Index(ids_where, k)));
   }
   return ids;
+}
+
+// The optional `unmeasured` ranges of a lane with `count` control points: [first, last]
+// index pairs, ascending and disjoint, within the points; empty when absent.
+std::vector<std::pair<std::size_t, std::size_t>> OptionalRanges(const nlohmann::json& j,
+                                                                std::size_t count,
+                                                                const std::string& where) {
+  std::vector<std::pair<std::size_t, std::size_t>> ranges;
+  if (!j.contains("unmeasured")) return ranges;
+  const std::string ranges_where = Key(where, "unmeasured");
+  const nlohmann::json& array = json_io::ReadArray(j.at("unmeasured"), ranges_where);
+  for (std::size_t k = 0; k < array.size(); ++k) {
+    const std::string range_where = Index(ranges_where, k);
+    const nlohmann::json& pair = json_io::ReadArray(array[k], range_where);
+    if (pair.size() != 2) Fail(range_where, "expected [first, last]");
+    const std::uint64_t first = json_io::ReadUint64(pair[0], Index(range_where, 0));
+    const std::uint64_t last = json_io::ReadUint64(pair[1], Index(range_where, 1));
+    if (first > last || last >= count) {
+      Fail(range_where,
+           "expected first <= last < " + std::to_string(count) + " (the lane's control points)");
+    }
+    if (!ranges.empty() && first <= ranges.back().second) {
+      Fail(range_where, "ranges must ascend without overlap");
+    }
+    ranges.emplace_back(first, last);
+  }
+  return ranges;
 }
 
 MapMarking MarkingFromJson(const nlohmann::json& j, const std::string& where) {
@@ -117,6 +147,7 @@ MapLane LaneFromJson(const nlohmann::json& j, const std::string& where) {
   for (std::size_t k = 0; k < points.size(); ++k) {
     lane.control_points_map.push_back(json_io::ReadVector3(points[k], Index(points_where, k)));
   }
+  lane.unmeasured = OptionalRanges(j, lane.control_points_map.size(), where);
   lane.observations = json_io::OptionalInt(j, "observations", 0, where);
   lane.first_seen = json_io::OptionalNumber(j, "first_seen", 0.0, where);
   lane.last_seen = json_io::OptionalNumber(j, "last_seen", 0.0, where);

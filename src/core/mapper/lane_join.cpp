@@ -8,6 +8,7 @@
 
 #include "ipm_road_mapper/core/geometry/catmull_rom_spline.h"
 #include "ipm_road_mapper/core/geometry/principal_axis.h"
+#include "ipm_road_mapper/core/mapper/lane_unmeasured.h"
 
 namespace ipm_road_mapper {
 namespace {
@@ -233,11 +234,13 @@ std::optional<PairAnalysis> Analyze(const LaneElement& first, const LaneElement&
   return a;
 }
 
-// `first` with `cps` as its control points and `second`'s observations merged in.
+// `first` with `cps` as its control points, those with `unmeasured` set unmeasured, and
+// `second`'s observations merged in.
 LaneElement Joined(const LaneElement& first, const LaneElement& second,
-                   std::vector<Eigen::Vector3d> cps) {
+                   std::vector<Eigen::Vector3d> cps, const std::vector<bool>& unmeasured) {
   LaneElement joined = first;
   joined.control_points_map = std::move(cps);
+  joined.unmeasured_cps = RangesOf(unmeasured, first.first_cp_index);
   MergeObservations(second, &joined);
   joined.optimized = first.optimized || second.optimized;
   joined.retired_before_frame = std::min(first.retired_before_frame, second.retired_before_frame);
@@ -356,13 +359,23 @@ std::optional<LaneElement> JoinLanes(const LaneElement& first, const LaneElement
   const double x_second_start = std::max(a->second.x_min, a->x_meet);
   const std::vector<Eigen::Vector3d>& cf = first.control_points_map;
   const std::vector<Eigen::Vector3d>& cs = second.control_points_map;
+  // Each kept point keeps its lane's flag (lane_unmeasured.h); the bridge's points are
+  // interpolated, measured by no pixel.
   std::vector<Eigen::Vector3d> cps = {cf.front()};  // first's phantom start
+  std::vector<bool> unmeasured = {false};
   for (std::size_t j = 1; j + 1 < cf.size(); ++j) {
-    if (a->frame.Local(cf[j]).x() <= x_first_end) cps.push_back(cf[j]);
+    if (a->frame.Local(cf[j]).x() <= x_first_end) {
+      cps.push_back(cf[j]);
+      unmeasured.push_back(ControlPointUnmeasured(first, j));
+    }
   }
   std::vector<Eigen::Vector3d> tail;
+  std::vector<bool> tail_unmeasured;
   for (std::size_t j = 1; j + 1 < cs.size(); ++j) {
-    if (a->frame.Local(cs[j]).x() >= x_second_start) tail.push_back(cs[j]);
+    if (a->frame.Local(cs[j]).x() >= x_second_start) {
+      tail.push_back(cs[j]);
+      tail_unmeasured.push_back(ControlPointUnmeasured(second, j));
+    }
   }
   if (cps.size() < 2 || tail.empty()) return std::nullopt;
   // The bridge: a cubic (Hermite) from first's last kept control point to second's first,
@@ -380,12 +393,15 @@ std::optional<LaneElement> JoinLanes(const LaneElement& first, const LaneElement
     const double y = h00 * la.y() + h10 * length * slope_a + h01 * lb.y() + h11 * length * slope_b;
     const Eigen::Vector2d p = a->frame.Map(la.x() + t * length, y);
     cps.emplace_back(p.x(), p.y(), (1.0 - t) * from.z() + t * to.z());
+    unmeasured.push_back(true);
   }
   cps.insert(cps.end(), tail.begin(), tail.end());
+  unmeasured.insert(unmeasured.end(), tail_unmeasured.begin(), tail_unmeasured.end());
   cps.push_back(2.0 * cps.back() - cps[cps.size() - 2]);
+  unmeasured.push_back(false);
   if (cps.size() < 4) return std::nullopt;
 
-  return Joined(first, second, std::move(cps));
+  return Joined(first, second, std::move(cps), unmeasured);
 }
 
 std::optional<LaneElement> JoinLanesThrough(const LaneElement& first, const LaneElement& second,
@@ -401,10 +417,20 @@ std::optional<LaneElement> JoinLanesThrough(const LaneElement& first, const Lane
   const auto first_to = cf.end() - 1 - static_cast<std::ptrdiff_t>(first_end_dropped);
   const auto second_from = cs.begin() + 1 + static_cast<std::ptrdiff_t>(second_start_dropped);
   std::vector<Eigen::Vector3d> cps(cf.begin(), first_to);
+  std::vector<bool> unmeasured;
+  for (std::size_t j = 0; j < cps.size(); ++j) {
+    unmeasured.push_back(ControlPointUnmeasured(first, j));
+  }
+  // The bridge's points: no pixel measured them (no frame saw the gap).
   cps.insert(cps.end(), bridge_map.begin(), bridge_map.end());
-  cps.insert(cps.end(), second_from, cs.end() - 1);
+  unmeasured.resize(cps.size(), true);
+  for (auto it = second_from; it != cs.end() - 1; ++it) {
+    cps.push_back(*it);
+    unmeasured.push_back(ControlPointUnmeasured(second, it - cs.begin()));
+  }
   cps.push_back(2.0 * cps.back() - cps[cps.size() - 2]);
-  return Joined(first, second, std::move(cps));
+  unmeasured.push_back(false);
+  return Joined(first, second, std::move(cps), unmeasured);
 }
 
 }  // namespace ipm_road_mapper

@@ -10,6 +10,7 @@
 #include "ipm_road_mapper/core/geometry/ipm.h"
 #include "ipm_road_mapper/core/geometry/trajectory_road_plane.h"
 #include "ipm_road_mapper/core/mapper/lane_topology.h"
+#include "ipm_road_mapper/core/mapper/lane_unmeasured.h"
 #include "ipm_road_mapper/core/mapper/pose_extrapolator.h"
 #include "ipm_road_mapper/core/mapper/timing_series.h"
 
@@ -255,6 +256,8 @@ bool Mapper::ExportLane(const LaneElement& element, MapLane* lane, std::size_t f
     const auto& cps = element.control_points_map;
     lane->control_points_map.assign(cps.begin() + std::min(from, cps.size()), cps.end());
   }
+  lane->unmeasured = ExportedUnmeasured(element, std::min(from, element.control_points_map.size()),
+                                        lane->control_points_map.size());
   lane->observations = static_cast<int>(element.Observations());
   lane->first_seen = element.first_seen;
   lane->last_seen = element.last_seen;

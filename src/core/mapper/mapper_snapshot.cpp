@@ -1,6 +1,7 @@
 // Mapper::ExportSnapshot: the live snapshot's export in shared storage (snapshot_cache.h).
 #include <algorithm>
 
+#include "ipm_road_mapper/core/mapper/lane_unmeasured.h"
 #include "ipm_road_mapper/core/mapper/mapper.h"
 
 namespace ipm_road_mapper {
@@ -83,6 +84,9 @@ SharedVectorMap Mapper::ExportSnapshot(std::size_t max_trajectory_poses,
       }
       MapLane exported;
       if (!ExportLane(element, &exported, keep * chunk_points)) continue;
+      // The fields are the whole lane's: its unmeasured points over the kept chunks too.
+      exported.unmeasured =
+          ExportedUnmeasured(element, 0, keep * chunk_points + exported.control_points_map.size());
       cache->lane_points_built += exported.control_points_map.size();
       std::shared_ptr<SharedLane> built = ShareLane(std::move(exported), chunk_points);
       if (keep > 0) {

@@ -7,6 +7,7 @@
 #include <array>
 #include <cstddef>
 #include <cstdint>
+#include <utility>
 #include <vector>
 
 #include "ipm_road_mapper/core/frontend/observations.h"
@@ -125,6 +126,10 @@ struct LaneElement {
   std::size_t first_frame = 0, last_frame = 0;
   double first_seen = 0.0, last_seen = 0.0;
   bool optimized = false;  // control points refined by a lane residual
+  // Control points a join laid across a gap in the line's observations (lane_unmeasured.h):
+  // no pixel measured them. Inclusive ranges of global indices (first_cp_index's),
+  // ascending and disjoint.
+  std::vector<std::pair<std::int64_t, std::int64_t>> unmeasured_cps;
   // Every observation ever made, pruned ones included.
   std::size_t Observations() const { return history.size() + pruned; }
   // Whether export shows it: seen at least twice (seen once, it is tentative).

@@ -10,6 +10,7 @@
 #include <optional>
 #include <stdexcept>
 #include <string>
+#include <utility>
 #include <vector>
 
 #include "ipm_road_mapper/core/geometry/rigid_transform.h"
@@ -51,6 +52,10 @@ struct MapLane {
   std::string class_name;
   std::string style;  // "solid", "dashed" or "" when unknown
   std::vector<Eigen::Vector3d> control_points_map;
+  // The control points no pixel measured: laid by a join across a gap in the line's
+  // observations (lane_unmeasured.h), as inclusive [first, last] ranges of indices into
+  // control_points_map, ascending and disjoint; empty: every point measured.
+  std::vector<std::pair<std::size_t, std::size_t>> unmeasured;
   int observations = 0;
   double first_seen = 0.0;
   double last_seen = 0.0;
