@@ -115,6 +115,15 @@ TEST(GeoJsonExportTest, LaneIsTheSplineSampledEveryHalfMeter) {
   }
 }
 
+TEST(GeoJsonExportTest, ALanesUnmeasuredControlPointsAreAProperty) {
+  VectorMap map = SmallMap();
+  EXPECT_EQ(VectorMapToGeoJson(map, std::nullopt)["features"][1]["properties"]["unmeasured"],
+            json::array());
+  map.lanes[0].unmeasured = {{2, 3}};
+  EXPECT_EQ(VectorMapToGeoJson(map, std::nullopt)["features"][1]["properties"]["unmeasured"],
+            json::parse("[[2, 3]]"));
+}
+
 TEST(GeoJsonExportTest, ShortLanesDegradeGracefully) {
   VectorMap map = SmallMap();
   map.lanes[0].control_points_map.resize(2);

@@ -4,6 +4,7 @@
 #include <gtest/gtest.h>
 
 #include <GeographicLib/LocalCartesian.hpp>
+#include <algorithm>
 #include <filesystem>
 #include <fstream>
 #include <map>
@@ -232,6 +233,43 @@ TEST(Lanelet2Export, LineAndMarkingTags) {
   EXPECT_EQ(stripe->tags.at("type"), "road_marking");
   EXPECT_EQ(stripe->tags.at("subtype"), "crosswalk_stripe &amp; co");  // escaped in the XML
   EXPECT_EQ(stripe->tags.at("irm:complete"), "no");
+}
+
+// The middle line's control points 8-10 (x 40-50 m) were laid by a join: its nodes from the
+// last measured control point before them (x 35 m) to the first after (55 m) carry
+// irm:measured = no, whichever way the line was stored; no other node does.
+TEST(Lanelet2Export, NodesOfALaneStretchNoPixelMeasuredAreTagged) {
+  for (const bool stored_backwards : {false, true}) {
+    VectorMap map = ThreeLaneMap();
+    MapLane& middle = map.lanes[1];
+    if (stored_backwards) {
+      std::reverse(middle.control_points_map.begin(), middle.control_points_map.end());
+      middle.unmeasured = {{10, 12}};  // 21 points: 20 - 10 .. 20 - 8
+    } else {
+      middle.unmeasured = {{8, 10}};
+    }
+    const Osm osm = Parse(VectorMapToLanelet2Osm(map, Munich()));
+    int tagged = 0;
+    for (const auto& [id, w] : osm.ways) {
+      if (!w.tags.count("type") || w.tags.at("type") != "line_thin") continue;
+      const bool is_middle = w.tags.at("irm:id") == "2";
+      for (std::uint64_t n : w.nodes) {
+        const Osm::Node& node = osm.nodes.at(n);
+        const double x = std::stod(node.tags.at("local_x"));
+        const bool flagged = node.tags.count("irm:measured") > 0;
+        if (flagged) {
+          EXPECT_EQ(node.tags.at("irm:measured"), "no");
+          ++tagged;
+        }
+        if (!is_middle || x < 34.9 || x > 55.1) {
+          EXPECT_FALSE(flagged) << "line " << w.tags.at("irm:id") << " x " << x;
+        } else if (x > 35.1 && x < 54.9) {
+          EXPECT_TRUE(flagged) << "x " << x << " backwards " << stored_backwards;
+        }
+      }
+    }
+    EXPECT_GE(tagged, 38) << stored_backwards;  // 20 m every 0.5 m
+  }
 }
 
 TEST(Lanelet2Export, NodesAreOnWgs84AtTheirMapFrameMetres) {

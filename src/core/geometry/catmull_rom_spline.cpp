@@ -141,6 +141,14 @@ double CatmullRomSpline::ParameterAtArcLength(double arc_m) const {
 }
 
 std::vector<Eigen::Vector3d> CatmullRomSpline::SampleByArcLength(double spacing_m) const {
+  const std::vector<double> parameters = SampleParametersByArcLength(spacing_m);
+  std::vector<Eigen::Vector3d> samples;
+  samples.reserve(parameters.size());
+  for (double s : parameters) samples.push_back(Evaluate(s));
+  return samples;
+}
+
+std::vector<double> CatmullRomSpline::SampleParametersByArcLength(double spacing_m) const {
   if (!(spacing_m > 0.0) || !std::isfinite(spacing_m)) {
     throw std::invalid_argument("CatmullRomSpline::SampleByArcLength: spacing must be > 0");
   }
@@ -157,13 +165,11 @@ std::vector<Eigen::Vector3d> CatmullRomSpline::SampleByArcLength(double spacing_
     wanted = kMaxArcLengthSamples;
   }
   const int count = std::max(0, static_cast<int>(wanted));
-  std::vector<Eigen::Vector3d> samples;
-  samples.reserve(static_cast<std::size_t>(count) + 1);
-  for (int k = 0; k < count; ++k) {
-    samples.push_back(Evaluate(ParameterAtArcLength(k * spacing)));
-  }
-  samples.push_back(Evaluate(NumSegments()));
-  return samples;
+  std::vector<double> parameters;
+  parameters.reserve(static_cast<std::size_t>(count) + 1);
+  for (int k = 0; k < count; ++k) parameters.push_back(ParameterAtArcLength(k * spacing));
+  parameters.push_back(NumSegments());
+  return parameters;
 }
 
 double CatmullRomSpline::MinimizeInBracket(int segment, const Eigen::Vector3d& query, double u,

@@ -88,6 +88,9 @@ nlohmann::json LaneFeature(const MapLane& lane, const PositionConverter& convert
   for (const Eigen::Vector3d& c_map : lane.control_points_map) {
     control_points.push_back(Rounded(c_map, kMetricScale));
   }
+  // The control points no pixel measured, as in map.json.
+  nlohmann::json unmeasured = nlohmann::json::array();
+  for (const auto& [first, last] : lane.unmeasured) unmeasured.push_back({first, last});
   nlohmann::json geometry = nullptr;
   const std::vector<Eigen::Vector3d> polyline = LanePolyline(lane, kLaneSampleSpacing_m);
   if (polyline.size() >= 2) {
@@ -105,6 +108,7 @@ nlohmann::json LaneFeature(const MapLane& lane, const PositionConverter& convert
       {"first_seen", lane.first_seen},
       {"last_seen", lane.last_seen},
       {"control_points", control_points},
+      {"unmeasured", unmeasured},
       {"coordinate_system", converter.CoordinateSystem()}};
   return {{"type", "Feature"}, {"id", lane.id}, {"geometry", geometry}, {"properties", properties}};
 }

@@ -59,14 +59,17 @@ class OsmWriter {
  public:
   explicit OsmWriter(const GeoOrigin& origin) : to_wgs84_(origin) {}
 
-  std::uint64_t Node(const Eigen::Vector3d& p_map) {
+  // A point; `unmeasured`: on a stretch of a lane line no pixel measured (irm:measured no).
+  std::uint64_t Node(const Eigen::Vector3d& p_map, bool unmeasured = false) {
     const Wgs84Point p = to_wgs84_.Convert(p_map);
     const std::uint64_t id = next_id_++;
     nodes_ << "  <node id=\"" << id << "\" visible=\"true\" version=\"1\" lat=\""
            << Fixed(p.latitude_deg, 9) << "\" lon=\"" << Fixed(p.longitude_deg, 9) << "\">\n";
-    WriteTags(&nodes_, {{"ele", Fixed(p.altitude_m, 4)},
-                        {"local_x", Fixed(p_map.x(), 4)},
-                        {"local_y", Fixed(p_map.y(), 4)}});
+    Tags tags = {{"ele", Fixed(p.altitude_m, 4)},
+                 {"local_x", Fixed(p_map.x(), 4)},
+                 {"local_y", Fixed(p_map.y(), 4)}};
+    if (unmeasured) tags.emplace_back("irm:measured", "no");
+    WriteTags(&nodes_, tags);
     nodes_ << "  </node>\n";
     ++stats_.nodes;
     return id;
@@ -184,11 +187,16 @@ std::string VectorMapToLanelet2Osm(const VectorMap& map, const GeoOrigin& origin
   // Lane lines, oriented along the drive; lanes without geometry are not written.
   std::vector<const MapLane*> lanes;
   std::vector<std::vector<Eigen::Vector3d>> lines;
+  std::vector<std::vector<bool>> unmeasured;  // per line sample (LanePolyline)
   for (const MapLane& lane : map.lanes) {
-    std::vector<Eigen::Vector3d> polyline = LanePolyline(lane, kLaneSampleSpacing_m);
+    std::vector<bool> flags;
+    std::vector<Eigen::Vector3d> polyline = LanePolyline(lane, kLaneSampleSpacing_m, &flags);
     if (polyline.size() < 2) continue;
     lanes.push_back(&lane);
+    const Eigen::Vector3d front = polyline.front();
     lines.push_back(LaneOrientedAlongDrive(std::move(polyline), map.trajectory));
+    if (lines.back().front() != front) std::reverse(flags.begin(), flags.end());
+    unmeasured.push_back(std::move(flags));
   }
   const LaneletLayout layout = PairLanelets(lines);
   std::vector<std::vector<double>> arcs;
@@ -205,14 +213,16 @@ std::string VectorMapToLanelet2Osm(const VectorMap& map, const GeoOrigin& origin
     }
     const Tags element = ElementTags(lanes[i]->id, lanes[i]->class_name);
     tags.insert(tags.end(), element.begin(), element.end());
-    std::vector<std::uint64_t> piece{osm.Node(lines[i].front())};
+    const std::vector<bool>& laid = unmeasured[i];
+    std::vector<std::uint64_t> piece{osm.Node(lines[i].front(), laid.front())};
     double last_arc = 0.0;  // of the piece's last node
     std::size_t next_cut = 0;
     for (std::size_t k = 1; k < lines[i].size(); ++k) {
       while (next_cut < cuts.size() && cuts[next_cut] < arc[k]) {
-        // A cut on a sample is that sample's node.
+        // A cut on a sample is that sample's node; between two, unmeasured if either is.
         if (cuts[next_cut] - last_arc > kSameNodeM) {
-          piece.push_back(osm.Node(PointAtArcLength(lines[i], arc, cuts[next_cut])));
+          piece.push_back(
+              osm.Node(PointAtArcLength(lines[i], arc, cuts[next_cut]), laid[k - 1] || laid[k]));
           last_arc = cuts[next_cut];
         }
         piece_ways[i].push_back(osm.Way(piece, tags));
@@ -220,7 +230,7 @@ std::string VectorMapToLanelet2Osm(const VectorMap& map, const GeoOrigin& origin
         ++next_cut;
       }
       if (arc[k] - last_arc > kSameNodeM) {
-        piece.push_back(osm.Node(lines[i][k]));
+        piece.push_back(osm.Node(lines[i][k], laid[k]));
         last_arc = arc[k];
       }
     }

@@ -3,7 +3,7 @@
 #include <cmath>
 #include <stdexcept>
 
-#include "ipm_road_mapper/core/geometry/catmull_rom_spline.h"
+#include "ipm_road_mapper/core/map/lane_samples.h"
 
 namespace ipm_road_mapper {
 
@@ -20,15 +20,24 @@ Wgs84Point MapToWgs84::Convert(const Eigen::Vector3d& p_map) const {
   return p;
 }
 
-std::vector<Eigen::Vector3d> LanePolyline(const MapLane& lane, double spacing_m) {
-  if (lane.control_points_map.size() >= 4) {
+std::vector<Eigen::Vector3d> LanePolyline(const MapLane& lane, double spacing_m,
+                                          std::vector<bool>* unmeasured) {
+  const std::size_t n = lane.control_points_map.size();
+  if (unmeasured) unmeasured->clear();
+  if (n >= 4) {
     try {
-      return CatmullRomSpline(lane.control_points_map).SampleByArcLength(spacing_m);
+      LaneSamples samples =
+          SampleLane(lane.control_points_map, UnmeasuredPointFlags(lane), spacing_m);
+      if (unmeasured) *unmeasured = std::move(samples.unmeasured);
+      return std::move(samples.points);
     } catch (const std::invalid_argument&) {
       return {};  // a non-finite control point: no geometry rather than a broken one
     }
   }
-  if (lane.control_points_map.size() >= 2) return lane.control_points_map;
+  if (n >= 2) {
+    if (unmeasured) *unmeasured = UnmeasuredPointFlags(lane);
+    return lane.control_points_map;
+  }
   return {};
 }
 

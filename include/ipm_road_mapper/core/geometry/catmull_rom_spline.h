@@ -98,6 +98,8 @@ class CatmullRomSpline {
   // Length() / kMaxArcLengthSamples instead, so the count (and memory) stays bounded.
   // Throws std::invalid_argument unless spacing_m > 0 and the length is finite.
   std::vector<Eigen::Vector3d> SampleByArcLength(double spacing_m) const;
+  // The global parameters of those samples (same throws).
+  std::vector<double> SampleParametersByArcLength(double spacing_m) const;
 
   // Global closest curve point to `query` over all segments. Queries beyond an end get that
   // end (s = 0 or s = NumSegments()). Segments whose bounding sphere is farther than the best

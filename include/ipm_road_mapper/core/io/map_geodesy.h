@@ -37,6 +37,8 @@ class MapToWgs84 {
 
 // A lane's spline sampled every `spacing_m` of arc length (map frame). A lane with 2-3
 // control points gives its control points, fewer (or a non-finite control point) nothing.
-std::vector<Eigen::Vector3d> LanePolyline(const MapLane& lane, double spacing_m);
+// With `unmeasured`, per sample whether it lies on a stretch no pixel measured (lane_samples.h).
+std::vector<Eigen::Vector3d> LanePolyline(const MapLane& lane, double spacing_m,
+                                          std::vector<bool>* unmeasured = nullptr);
 
 }  // namespace ipm_road_mapper
