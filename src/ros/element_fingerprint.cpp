@@ -60,6 +60,8 @@ std::size_t FieldsFingerprint(const MapLane& lane) {
   HashClass(&seed, lane.class_id, lane.class_name);
   HashCombine(&seed, std::hash<std::string>()(lane.style));
   HashLife(&seed, lane.observations, lane.first_seen, lane.last_seen);
+  // Not the unmeasured flags: a join sets them with the points it lays, so they change only
+  // with their points, which the patch re-sends with them.
   // The topology: a new link re-sends the lane's fields (its patch carries the links).
   for (const auto* ids : {&lane.predecessors, &lane.successors}) {
     HashCombine(&seed, ids->size());

@@ -9,7 +9,7 @@
 #include <string>
 #include <vector>
 
-#include "ipm_road_mapper/core/geometry/catmull_rom_spline.h"
+#include "ipm_road_mapper/core/map/lane_samples.h"
 #include "ipm_road_mapper/ros/element_fingerprint.h"
 #include "ipm_road_mapper/ros/msg_conversion.h"
 
@@ -34,6 +34,9 @@ std_msgs::ColorRGBA Rgba(float r, float g, float b, float a = 1.0f) {
   return c;
 }
 
+// Where a lane line is laid, not measured (MapLane::unmeasured).
+const std_msgs::ColorRGBA kUnmeasuredColor = Rgba(0.5f, 0.5f, 0.5f, 0.5f);
+
 int MarkerId(std::uint64_t element_id) { return static_cast<int>(element_id & 0x7fffffffu); }
 
 visualization_msgs::Marker NewMarker(const std::string& ns, int id, int type,
@@ -52,14 +55,17 @@ visualization_msgs::Marker NewMarker(const std::string& ns, int id, int type,
 
 // Points along the curve of control points [first, last) (segments first .. last - 4); the
 // control points themselves when no spline can be built (fewer than 4 or non-finite points).
-std::vector<Eigen::Vector3d> CurveSamples(const std::vector<Eigen::Vector3d>& control_points,
-                                          std::size_t first, std::size_t last, double spacing_m) {
+// The curve of control points [first, last) sampled every spacing_m, with per sample whether
+// it lies on a stretch no pixel measured (lane_samples.h; `unmeasured` per control point).
+LaneSamples CurveSamples(const std::vector<Eigen::Vector3d>& control_points, std::size_t first,
+                         std::size_t last, double spacing_m, const std::vector<bool>& unmeasured) {
   const std::vector<Eigen::Vector3d> part(control_points.begin() + first,
                                           control_points.begin() + last);
+  const std::vector<bool> part_unmeasured(unmeasured.begin() + first, unmeasured.begin() + last);
   try {
-    return CatmullRomSpline(part).SampleByArcLength(spacing_m);
+    return SampleLane(part, part_unmeasured, spacing_m);
   } catch (const std::exception&) {
-    return part;
+    return {part, part_unmeasured};
   }
 }
 
@@ -153,6 +159,7 @@ std::size_t MarkerBuilder::AddLane(const MapLane& lane, std::size_t first_change
   const std::size_t count = LaneChunkCount(points, lane_chunk_segments_);
   std::size_t& drawn = lane_chunks_[lane.id];
   drawn = std::max(drawn, count);
+  const std::vector<bool> unmeasured = UnmeasuredPointFlags(lane);
   // The first chunk whose curve (points [curve_first, curve_first + segments + 3)) reaches
   // the first changed point; the earlier ones are as drawn.
   const std::size_t first_chunk =
@@ -174,9 +181,13 @@ std::size_t MarkerBuilder::AddLane(const MapLane& lane, std::size_t first_change
     Marker line = NewMarker(kNamespaces[kLaneNs], id, Marker::LINE_STRIP, frame_id, stamp);
     line.scale.x = 0.15;  // line width, m (a painted lane line)
     line.color = color;
-    for (const Eigen::Vector3d& p :
-         CurveSamples(cps, curve_first, curve_last, lane_sample_spacing_m_)) {
-      line.points.push_back(ToPointMsg(p));
+    const LaneSamples samples =
+        CurveSamples(cps, curve_first, curve_last, lane_sample_spacing_m_, unmeasured);
+    for (const Eigen::Vector3d& p : samples.points) line.points.push_back(ToPointMsg(p));
+    // A stretch no pixel measured (laid by a join) is drawn grey and faint.
+    const std::vector<bool>& laid = samples.unmeasured;
+    if (std::find(laid.begin(), laid.end(), true) != laid.end()) {
+      for (const bool l : laid) line.colors.push_back(l ? kUnmeasuredColor : color);
     }
     if (line.points.size() >= 2) Add(kLaneNs, fingerprint, std::move(line), out);
     Marker points_marker =

@@ -13,7 +13,34 @@ ros::Time SafeTime(double seconds) {
   return FromSeconds(seconds);
 }
 
+// The lane's unmeasured flags for its control points from `from` on: empty when none is.
+std::vector<std::uint8_t> UnmeasuredFlags(const MapLane& lane, std::size_t from) {
+  const std::size_t count = lane.control_points_map.size();
+  std::vector<std::uint8_t> flags;
+  for (const auto& [first, last] : lane.unmeasured) {
+    if (last < from || first >= count) continue;
+    flags.resize(count - from, 0);
+    for (std::size_t i = std::max(first, from); i <= std::min(last, count - 1); ++i) {
+      flags[i - from] = 1;
+    }
+  }
+  return flags;
+}
+
 }  // namespace
+
+void AddUnmeasuredFlags(const std::vector<std::uint8_t>& flags, std::size_t first_index,
+                        MapLane* lane) {
+  for (std::size_t i = 0; i < flags.size(); ++i) {
+    if (flags[i] == 0) continue;
+    const std::size_t index = first_index + i;
+    if (!lane->unmeasured.empty() && lane->unmeasured.back().second + 1 == index) {
+      lane->unmeasured.back().second = index;
+    } else {
+      lane->unmeasured.emplace_back(index, index);
+    }
+  }
+}
 
 ipm_road_mapper::MarkingPolygon ToMarkingMsg(const MapMarking& marking) {
   ipm_road_mapper::MarkingPolygon m;
@@ -38,6 +65,7 @@ ipm_road_mapper::LaneSpline ToLaneMsg(const MapLane& lane) {
   l.control_points.reserve(lane.control_points_map.size());
   for (const Eigen::Vector3d& c : lane.control_points_map)
     l.control_points.push_back(ToPointMsg(c));
+  l.unmeasured = UnmeasuredFlags(lane, 0);
   l.observations = lane.observations;
   l.first_seen = SafeTime(lane.first_seen);
   l.last_seen = SafeTime(lane.last_seen);
@@ -58,6 +86,7 @@ ipm_road_mapper::LaneSplinePatch ToLanePatchMsg(const MapLane& lane, std::size_t
   patch.control_points.reserve(cps.size() - from);
   for (std::size_t i = from; i < cps.size(); ++i)
     patch.control_points.push_back(ToPointMsg(cps[i]));
+  patch.unmeasured = UnmeasuredFlags(lane, from);
   patch.observations = lane.observations;
   patch.first_seen = SafeTime(lane.first_seen);
   patch.last_seen = SafeTime(lane.last_seen);
@@ -104,6 +133,7 @@ VectorMap FromVectorMapMsg(const ipm_road_mapper::VectorMapMsg& msg) {
     lane.class_name = l.class_name;
     lane.style = l.style == "unknown" ? "" : l.style;
     for (const auto& c : l.control_points) lane.control_points_map.push_back(FromPointMsg(c));
+    if (l.unmeasured.size() == l.control_points.size()) AddUnmeasuredFlags(l.unmeasured, 0, &lane);
     lane.observations = l.observations;
     lane.first_seen = ToSeconds(l.first_seen);
     lane.last_seen = ToSeconds(l.last_seen);

@@ -120,7 +120,37 @@ void ExpectSameMap(const VectorMap& a, const VectorMap& b) {
     EXPECT_EQ(it->observations, l.observations);
     EXPECT_EQ(it->predecessors, l.predecessors) << l.id;
     EXPECT_EQ(it->successors, l.successors) << l.id;
+    EXPECT_EQ(it->unmeasured, l.unmeasured) << l.id;
   }
+}
+
+TEST(MarkerBuilder, ALaneStretchNoPixelMeasuredIsDrawnGrey) {
+  MarkerBuilder builder(0.5, 16);
+  VectorMap map;
+  map.lanes.push_back(StraightLane(3, 20, 1.7));  // x = -2 .. 36: chunks of 16 and 1 segments
+  map.lanes.push_back(StraightLane(4, 20, -1.7));
+  map.lanes[0].unmeasured = {{8, 9}};  // x 14 and 16: the curve from x 12 to 18 is laid
+  const auto out = builder.Build(map, "map", ros::Time(1.0), MarkerBuilder::Mode::kChanges);
+  int lines = 0;
+  for (const Marker& m : out.markers) {
+    if (m.ns != "lanes") continue;
+    ++lines;
+    if (m.id != LaneChunkMarkerId(3, 0)) {
+      EXPECT_TRUE(m.colors.empty());  // measured throughout: the line's one colour
+      continue;
+    }
+    ASSERT_EQ(m.colors.size(), m.points.size());
+    for (std::size_t i = 0; i < m.points.size(); ++i) {
+      const double x = m.points[i].x;
+      const bool grey = m.colors[i].r == m.colors[i].g && m.colors[i].a < 1.0f;
+      if (x > 12.1 && x < 17.9) EXPECT_TRUE(grey) << x;
+      if (x < 11.9 || x > 18.1) {
+        EXPECT_FALSE(grey) << x;
+        EXPECT_EQ(m.colors[i].a, m.color.a) << x;
+      }
+    }
+  }
+  EXPECT_EQ(lines, 4);
 }
 
 TEST(VectorMapDelta, AClientRebuildsTheMapFromTheDeltas) {
@@ -167,7 +197,28 @@ TEST(VectorMapDelta, AClientRebuildsTheMapFromTheDeltas) {
   EXPECT_EQ(delta.lanes[1].predecessors, (std::vector<std::uint64_t>{1}));
   ApplyVectorMapDelta(delta, &client);
   ExpectSameMap(map, client);
+  // A join lays lane 1's points 40-44 across a gap (unmeasured), then lane 1 grows on: the
+  // patches carry the flags of their points, the client keeps those before them.
+  for (std::size_t i = 40; i <= 44; ++i) map.lanes[0].control_points_map[i].y() += 0.02;
+  map.lanes[0].unmeasured = {{40, 44}};
+  delta = builder.Build(map, "map", ros::Time(3.6));
+  ASSERT_EQ(delta.lanes.size(), 1u);
+  EXPECT_EQ(delta.lanes[0].first_index, 32u);
+  ASSERT_EQ(delta.lanes[0].unmeasured.size(), delta.lanes[0].control_points.size());
+  EXPECT_EQ(delta.lanes[0].unmeasured[8], 1);
+  EXPECT_EQ(delta.lanes[0].unmeasured[7], 0);
+  ApplyVectorMapDelta(delta, &client);
+  ExpectSameMap(map, client);
+  map.lanes[0].control_points_map.emplace_back(103.0, 1.7, 0.0);
+  map.lanes[0].control_points_map[49].y() += 0.01;
+  delta = builder.Build(map, "map", ros::Time(3.7));
+  ASSERT_EQ(delta.lanes.size(), 1u);
+  EXPECT_EQ(delta.lanes[0].first_index, 48u);
+  EXPECT_TRUE(delta.lanes[0].unmeasured.empty());  // none of its points
+  ApplyVectorMapDelta(delta, &client);
+  ExpectSameMap(map, client);
   // A lane shrinks (re-fit) and another leaves the map.
+  map.lanes[0].unmeasured.clear();
   map.lanes[0].control_points_map.resize(30);
   map.lanes.erase(map.lanes.begin() + 1);
   delta = builder.Build(map, "map", ros::Time(4.0));
@@ -180,7 +231,7 @@ TEST(VectorMapDelta, AClientRebuildsTheMapFromTheDeltas) {
   // ~reset.
   delta = builder.Clear("map", ros::Time(5.0));
   EXPECT_TRUE(delta.reset);
-  EXPECT_EQ(delta.sequence, 6u);  // five deltas before it (the topology one included)
+  EXPECT_EQ(delta.sequence, 8u);  // seven deltas before it (the topology and flag ones included)
   ApplyVectorMapDelta(delta, &client);
   EXPECT_TRUE(client.markings.empty() && client.lanes.empty());
 }

@@ -35,7 +35,8 @@ VectorMap SomeMap() {
   lane.first_seen = 1000.0;
   lane.last_seen = 1002.0;
   lane.predecessors = {2};
-  lane.successors = {7, 9};  // a fork
+  lane.successors = {7, 9};    // a fork
+  lane.unmeasured = {{1, 2}};  // laid by a join
   map.lanes.push_back(lane);
   map.T_base_cam.linear() = RotationFromRpy(-1.6, 0.05, -1.55);
   map.T_base_cam.translation() = Eigen::Vector3d(1.5, 0.02, 1.45);
@@ -85,7 +86,15 @@ TEST(VectorMapConversion, RoundTripKeepsEveryField) {
   EXPECT_EQ(msg.lanes[0].successors, (std::vector<std::uint64_t>{7, 9}));
   EXPECT_EQ(back.lanes[0].predecessors, (std::vector<std::uint64_t>{2}));
   EXPECT_EQ(back.lanes[0].successors, (std::vector<std::uint64_t>{7, 9}));
+  EXPECT_EQ(msg.lanes[0].unmeasured, (std::vector<std::uint8_t>{0, 1, 1, 0, 0, 0}));
+  EXPECT_EQ(back.lanes[0].unmeasured, map.lanes[0].unmeasured);
   EXPECT_TRUE(back.T_base_cam.isApprox(map.T_base_cam, 1e-9));
+  // A patch carries the flags of its own points, none when none of them is unmeasured.
+  EXPECT_EQ(ToLanePatchMsg(map.lanes[0], 2).unmeasured, (std::vector<std::uint8_t>{1, 0, 0, 0}));
+  EXPECT_TRUE(ToLanePatchMsg(map.lanes[0], 3).unmeasured.empty());
+  VectorMap measured = map;
+  measured.lanes[0].unmeasured.clear();
+  EXPECT_TRUE(ToVectorMapMsg(measured, "map", ros::Time(1.0)).lanes[0].unmeasured.empty());
 }
 
 TEST(VectorMapConversion, UnknownStyleAndBadStampsAreSafe) {

@@ -5,6 +5,7 @@
 #include <nav_msgs/Path.h>
 #include <ros/time.h>
 
+#include <cstdint>
 #include <string>
 #include <vector>
 
@@ -22,6 +23,12 @@ ipm_road_mapper::LaneSpline ToLaneMsg(const MapLane& lane);
 // `from`; a caller holding a lane's tail sets the index in the whole lane): ToLaneMsg's
 // fields, only the points from `from` converted.
 ipm_road_mapper::LaneSplinePatch ToLanePatchMsg(const MapLane& lane, std::size_t from);
+
+// Per-point unmeasured flags (LaneSpline / LaneSplinePatch `unmeasured`, the first at
+// control point `first_index`) appended to `lane`'s ranges (MapLane::unmeasured); the lane's
+// ranges must end before first_index.
+void AddUnmeasuredFlags(const std::vector<std::uint8_t>& flags, std::size_t first_index,
+                        MapLane* lane);
 
 // VectorMap -> message in `frame_id` at `stamp`: markings (4 corners), lanes (control points,
 // phantom ends included), the refined extrinsic. Element stamps in seconds -> ros::Time.
