@@ -96,6 +96,19 @@ def print_tables(scenarios, results, table, fmt, real_absent=False):
               "drive", "markings matched / GT", "reachable / GT", "GT lines matched / all",
               "reachable / all", "lane F1 / ceiling", "on seen part / seen, APE (m)"], rows)
 
+    rows = []
+    for d in _drives(scenarios, results):
+        m = ours(d)
+        length = m.get("lane_km")
+        rows.append([d, "%s / %s" % (fmt(m.get("lane_unmeasured_length_m"), 1),
+                                     fmt(None if length is None else 1000.0 * length, 0)),
+                     fmt(m.get("lane_ape_unmeasured_mean_m")),
+                     fmt(m.get("lane_ape_measured_mean_m"))])
+    table("Table 5d. Lane stretches a join laid across a gap in the line's observations (map.json "
+          "`unmeasured`: no pixel measured them), and the lane APE there and elsewhere", [
+              "drive", "laid / mapped length (m)", "lane APE laid (m)", "lane APE measured (m)"],
+          rows)
+
     def ceiling(m, reachable_key, total_key):
         """' (view ceiling r / n)' when the drive's view caps the figure below its total."""
         if m.get(reachable_key) is None or m.get(reachable_key) == m.get(total_key):

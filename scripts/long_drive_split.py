@@ -85,6 +85,17 @@ def center(corners):
     return [sum(c[i] for c in corners) / len(corners) for i in range(3)]
 
 
+def piece_ranges(ranges, offset, count):
+    """A lane's `unmeasured` control-point ranges for its piece of `count` points from index
+    `offset` on: shifted into the piece, clipped to it."""
+    out = []
+    for first, last in ranges:
+        a, b = max(first - offset, 0), min(last - offset, count - 1)
+        if a <= b:
+            out.append([a, b])
+    return out
+
+
 def runs(flags):
     """[begin, end) of every maximal run of True in `flags`."""
     result, begin = [], None
@@ -145,7 +156,10 @@ class DriveSplit:
             c = lane["control_points"]
             for begin, end in runs([d0 <= d < d1 for d in distances]):
                 first, last = begin + 1, end  # segments first .. last, with phantom ends
-                part["lanes"].append(dict(lane, control_points=c[first - 1:last + 3],
+                points = c[first - 1:last + 3]
+                part["lanes"].append(dict(lane, control_points=points,
+                                          unmeasured=piece_ranges(lane.get("unmeasured", []),
+                                                                  first - 1, len(points)),
                                           id=len(part["lanes"]) + 1, predecessors=[],
                                           successors=[]))
         part["trajectory"] = [p for p in self.map.get("trajectory", [])

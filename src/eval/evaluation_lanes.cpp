@@ -8,6 +8,7 @@
 #include <stdexcept>
 
 #include "ipm_road_mapper/core/geometry/catmull_rom_spline.h"
+#include "ipm_road_mapper/core/map/lane_samples.h"
 #include "ipm_road_mapper/eval/evaluation.h"
 
 namespace ipm_road_mapper {
@@ -139,7 +140,7 @@ LaneMetrics EvaluateLanes(const VectorMap& map, const GroundTruth& gt,
   const bool have_gt = !gt.lanes.empty();
 
   // Mapped splines -> GT: per-sample errors, precision, and which GT lane each sample is on.
-  std::vector<double> errors, errors_xy, errors_z;
+  std::vector<double> errors, errors_xy, errors_z, errors_unmeasured, errors_measured;
   std::vector<std::vector<Eigen::Vector3d>> map_samples;
   std::vector<std::map<std::uint64_t, int>> on_samples_per_gt(gt.lanes.size());
   CheckLaneSampleBudget(map, options);
@@ -155,15 +156,22 @@ LaneMetrics EvaluateLanes(const VectorMap& map, const GroundTruth& gt,
     result.class_name = lane.class_name;
     result.control_points = static_cast<int>(lane.control_points_map.size());
     result.length_m = spline->Length();
-    map_samples.push_back(spline->SampleByArcLength(options.lane_sample_spacing_m));
+    LaneSamples samples = SampleLane(lane.control_points_map, UnmeasuredPointFlags(lane),
+                                     options.lane_sample_spacing_m);
+    for (const bool unmeasured : samples.unmeasured) {
+      if (unmeasured) metrics.unmeasured_length_m += options.lane_sample_spacing_m;
+    }
+    map_samples.push_back(std::move(samples.points));
     if (have_gt) {
       std::vector<double> lane_errors;
       std::vector<int> nearest_count(gt.lanes.size(), 0);
       int on_gt = 0;
-      for (const Eigen::Vector3d& sample : map_samples.back()) {
+      for (std::size_t k = 0; k < map_samples.back().size(); ++k) {
+        const Eigen::Vector3d& sample = map_samples.back()[k];
         const PolylineDistanceIndex::Nearest nearest = gt_index.Query(sample);
         const Eigen::Vector3d error = sample - nearest.point;
         lane_errors.push_back(nearest.distance_m);
+        (samples.unmeasured[k] ? errors_unmeasured : errors_measured).push_back(nearest.distance_m);
         errors_xy.push_back(error.head<2>().norm());
         errors_z.push_back(std::abs(error.z()));
         ++nearest_count[nearest.polyline];
@@ -186,6 +194,8 @@ LaneMetrics EvaluateLanes(const VectorMap& map, const GroundTruth& gt,
   }
   metrics.map_total = static_cast<int>(map.lanes.size());
   metrics.error_m = Summarize(errors);
+  metrics.error_unmeasured_m = Summarize(std::move(errors_unmeasured));
+  metrics.error_measured_m = Summarize(std::move(errors_measured));
   metrics.error_xy_mean_m = Summarize(errors_xy).mean;
   metrics.error_z_mean_m = Summarize(errors_z).mean;
 

@@ -95,6 +95,10 @@ void AddLanes(const LaneMetrics& m, nlohmann::json* j) {
   (*j)["lane_ape_xy_mean_m"] = Number(m.error_xy_mean_m);
   (*j)["lane_ape_z_mean_m"] = Number(m.error_z_mean_m);
   (*j)["lane_samples"] = m.error_m.count;
+  (*j)["lane_unmeasured_length_m"] = Number(m.unmeasured_length_m);
+  (*j)["lane_ape_unmeasured_mean_m"] = Number(m.error_unmeasured_m.mean);
+  (*j)["lane_ape_unmeasured_samples"] = m.error_unmeasured_m.count;
+  (*j)["lane_ape_measured_mean_m"] = Number(m.error_measured_m.mean);
   (*j)["lane_f1"] = Number(m.f1);
   (*j)["lane_precision"] = Number(m.precision);
   (*j)["lane_recall"] = Number(m.recall);

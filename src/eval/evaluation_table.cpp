@@ -89,6 +89,9 @@ void AddLaneRows(const Metrics& metrics, Table* t) {
   t->Row("APE median / max", Fixed(l.error_m.median, 3) + " / " + Fixed(l.error_m.max, 3), "", "m");
   t->Row("APE horizontal / vertical mean",
          Fixed(l.error_xy_mean_m, 3) + " / " + Fixed(l.error_z_mean_m, 3), "", "m");
+  t->Row("laid by a join (unmeasured): length / APE",
+         Fixed(l.unmeasured_length_m, 1) + " m / " + Fixed(l.error_unmeasured_m.mean, 3), "", "m");
+  t->Row("APE mean where measured", Fixed(l.error_measured_m.mean, 3), "", "m");
   t->Row("F1", Fixed(l.f1, 3), "", "");
   t->Row("precision (splines on GT / all)",
          Fixed(l.precision, 3) + " (" + Count(l.map_true_positive, l.map_total) + ")", "", "");

@@ -263,6 +263,26 @@ TEST_F(EvaluationTest, LaneF1CountsMissingSpuriousAndSplitLanes) {
   EXPECT_TRUE(m.map_lanes[1].true_positive);
 }
 
+TEST_F(EvaluationTest, LaneStretchesNoPixelMeasuredAreScoredApart) {
+  // Lane 0's control points every 3 m from x 0 (index 1): points 5-7 (x 12-18 m) laid 0.3 m
+  // beside the line by a join. The laid stretch runs from point 4 to point 8 (x 9-21 m).
+  VectorMap laid = map_;
+  MapLane& lane = laid.lanes[0];
+  for (std::size_t i = 5; i <= 7; ++i) lane.control_points_map[i].y() += 0.3;
+  LaneMetrics m = EvaluateLanes(laid, gt_, options_);
+  EXPECT_DOUBLE_EQ(m.unmeasured_length_m, 0.0);  // not flagged: scored as measured
+  EXPECT_EQ(m.error_unmeasured_m.count, 0);
+  EXPECT_GT(m.error_measured_m.max, 0.29);
+  lane.unmeasured = {{5, 7}};
+  m = EvaluateLanes(laid, gt_, options_);
+  EXPECT_NEAR(m.unmeasured_length_m, 12.0, 0.3);
+  EXPECT_GT(m.error_unmeasured_m.mean, 0.15);
+  // The rest lies on the line, but for the segment before the stretch, which a moved point
+  // also shapes (a Catmull-Rom segment depends on four points).
+  EXPECT_LT(m.error_measured_m.max, 0.05);
+  EXPECT_EQ(m.error_unmeasured_m.count + m.error_measured_m.count, m.error_m.count);
+}
+
 TEST_F(EvaluationTest, ExtrinsicErrorIsTheAppliedRotationAndTranslation) {
   const Eigen::Vector3d axis = Eigen::Vector3d(0.3, -1.0, 0.2).normalized();
   map_.T_base_cam.linear() =

@@ -96,6 +96,28 @@ class DriveSplitTest(unittest.TestCase):
                 self.assertEqual(lane["predecessors"], [])
                 self.assertEqual(lane["successors"], [])
 
+    def test_unmeasured_ranges_follow_their_points_into_the_pieces(self):
+        # Control points 30-36 (x 87-105 m) and 66 (x 195 m) were laid by a join: each piece
+        # flags exactly those of its points, at its own indices (evaluate_map refuses a range
+        # beyond a lane's points).
+        whole = vector_map()
+        whole["lanes"][0]["unmeasured"] = [[30, 36], [66, 66]]
+        laid_x = {3.0 * k - 3.0 for k in list(range(30, 37)) + [66]}
+        split = long_drive_split.DriveSplit(ground_truth(), whole, margin_m=30.0)
+        flagged = set()
+        for d0, d1 in self.parts:
+            for lane in split.map_part(d0, d1)["lanes"]:
+                c = lane["control_points"]
+                for first, last in lane["unmeasured"]:
+                    self.assertLessEqual(0, first)
+                    self.assertLessEqual(first, last)
+                    self.assertLess(last, len(c))
+                    flagged |= {c[i][0] for i in range(first, last + 1)}
+                for i, p in enumerate(c):
+                    inside = any(a <= i <= b for a, b in lane["unmeasured"])
+                    self.assertEqual(inside, p[0] in laid_x, p)
+        self.assertEqual(flagged, laid_x)
+
     def test_markings_frames_and_poses_are_cropped(self):
         map_part = self.split.map_part(100.0, 200.0)
         self.assertEqual([m["id"] for m in map_part["markings"]], [101])

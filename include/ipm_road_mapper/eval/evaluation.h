@@ -142,6 +142,11 @@ struct LaneMetrics {
   double f1 = kNoValue;
   double splines_per_matched_gt_lane = kNoValue;  // mean covering splines; 1 is ideal
   double mapped_length_m = 0.0;
+  // The mapped lines' stretches no pixel measured (MapLane::unmeasured, lane_samples.h): their
+  // length (samples x spacing) and the sample errors there and elsewhere (with GT).
+  double unmeasured_length_m = 0.0;
+  ErrorSummary error_unmeasured_m;
+  ErrorSummary error_measured_m;
   std::vector<MapLaneResult> map_lanes;
   std::vector<GroundTruthLaneResult> gt_lanes;
 };
