@@ -333,8 +333,11 @@ bool LaneContinues(const LaneElement& first, const LaneElement& second, const La
 }
 
 double LaneJoinCost(const LaneElement& first, const LaneElement& second,
-                    const LaneJoinOptions& join, const AssociationOptions& options) {
-  if (CoObserved(first, second)) return -1.0;
+                    const LaneJoinOptions& join, const AssociationOptions& options,
+                    bool* co_observed) {
+  const bool two_lines = CoObserved(first, second);
+  if (co_observed) *co_observed = two_lines;
+  if (two_lines) return -1.0;
   const auto a = Analyze(first, second, join, options);
   if (!a) return -1.0;
   const double x = a->x_meet;

@@ -2,6 +2,8 @@
 // across a gap no frame saw (lane_gap_visibility.h, lane_path_bridge.h).
 #include <algorithm>
 #include <cmath>
+#include <optional>
+#include <utility>
 
 #include "ipm_road_mapper/core/frontend/association.h"
 #include "ipm_road_mapper/core/mapper/change_log.h"
@@ -32,7 +34,7 @@ void LaneTracker::JoinFragments(std::size_t settled_before_frame) {
     }
     double best_cost = -1.0;
     std::size_t best_a = 0, best_b = 0;
-    bool best_hidden = false;
+    std::optional<PathBridge> best_bridge;  // the best pair's, when hidden
     for (std::size_t a : among) {
       for (std::size_t b : among) {
         if (a == b || lanes[a].class_id != lanes[b].class_id) continue;
@@ -44,25 +46,22 @@ void LaneTracker::JoinFragments(std::size_t settled_before_frame) {
             (ca[ca.size() - 2] - cb[1]).head<2>().norm() > reach_m) {
           continue;
         }
-        bool hidden = false;
-        const double cost = JoinCost(lanes[a], lanes[b], !online, &hidden);
+        std::optional<PathBridge> bridge;
+        const double cost = JoinCost(lanes[a], lanes[b], !online, &bridge);
         if (cost >= 0.0 && (best_cost < 0.0 || cost < best_cost)) {
           best_cost = cost;
           best_a = a;
           best_b = b;
-          best_hidden = hidden;
+          best_bridge = std::move(bridge);
         }
       }
     }
     if (best_cost < 0.0) return;
     std::optional<LaneElement> result;
-    if (best_hidden) {
-      const std::optional<PathBridge> bridge =
-          HiddenGapBridge(lanes[best_a], lanes[best_b], GapSpan(lanes[best_a], lanes[best_b]));
-      if (bridge) {
-        result = JoinLanesThrough(lanes[best_a], lanes[best_b], bridge->points,
-                                  bridge->first_end_dropped, bridge->second_start_dropped);
-      }
+    const bool hidden = best_bridge.has_value();
+    if (hidden) {
+      result = JoinLanesThrough(lanes[best_a], lanes[best_b], best_bridge->points,
+                                best_bridge->first_end_dropped, best_bridge->second_start_dropped);
     } else {
       result = JoinLanes(lanes[best_a], lanes[best_b], join, options_.association,
                          options_.lanes.fit.chord_spacing_m);
@@ -74,7 +73,7 @@ void LaneTracker::JoinFragments(std::size_t settled_before_frame) {
     store_->Touch(&lanes[best_a], changed_from);
     lanes.erase(lanes.begin() + best_b);
     ++counters_->lanes_joined;
-    if (best_hidden) ++counters_->lanes_joined_hidden_gap;
+    if (hidden) ++counters_->lanes_joined_hidden_gap;
   }
 }
 
@@ -85,17 +84,18 @@ void LaneTracker::SetCamera(const CameraIntrinsics& camera, const Eigen::Isometr
 }
 
 double LaneTracker::JoinCost(const LaneElement& first, const LaneElement& second, bool at_end,
-                             bool* hidden) const {
-  *hidden = false;
+                             std::optional<PathBridge>* hidden_bridge) const {
+  hidden_bridge->reset();
   const LaneJoinOptions& join = options_.lanes.join;
-  const double cost = LaneJoinCost(first, second, join, options_.association);
+  bool co_observed = false;
+  const double cost = LaneJoinCost(first, second, join, options_.association, &co_observed);
   if (cost >= 0.0 || !at_end || join.max_hidden_gap_m <= 0.0 || first.class_id != second.class_id ||
-      CoObserved(first, second)) {
+      co_observed) {
     return cost;
   }
   // A gap the ordinary join does not bridge: along the driven path, if no frame saw it.
   const FrameSpan span = GapSpan(first, second);
-  const std::optional<PathBridge> bridge = HiddenGapBridge(first, second, span);
+  std::optional<PathBridge> bridge = HiddenGapBridge(first, second, span);
   if (!bridge) return -1.0;
   // The two ends' offsets from the path agree within their combined floor sigma.
   const double sigma = std::sqrt(2.0) * LaneFloorSigma(options_.association);
@@ -111,7 +111,7 @@ double LaneTracker::JoinCost(const LaneElement& first, const LaneElement& second
   if (FramesThatSawGap(bridge->unseen_points, store_->frames(), span, gap_camera_, view) > 0) {
     return -1.0;
   }
-  *hidden = true;
+  *hidden_bridge = std::move(bridge);
   return path_cost;
 }
 

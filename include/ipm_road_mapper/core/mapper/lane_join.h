@@ -47,9 +47,11 @@ bool LaneContinues(const LaneElement& first, const LaneElement& second, const La
 // The same test as a cost: the larger of the offset's and the direction's disagreement in
 // combined sigmas (<= gate_sigmas), or -1 when `second` does not continue `first`. Of
 // several candidates the lowest cost is the continuation (at 0.5 m of odometry noise the
-// next lane's line 3.5 m beside can pass the gate too).
+// next lane's line 3.5 m beside can pass the gate too). With `co_observed`, also whether the
+// two were seen as two lines in one frame (CoObserved, the first test).
 double LaneJoinCost(const LaneElement& first, const LaneElement& second,
-                    const LaneJoinOptions& join, const AssociationOptions& options);
+                    const LaneJoinOptions& join, const AssociationOptions& options,
+                    bool* co_observed = nullptr);
 
 // `first` and `second` joined into one lane (first's id and control-point indices at its
 // start): first's control points up to its last data, a bridge over the gap on the blend of

@@ -86,13 +86,14 @@ class LaneTracker {
                    const std::vector<Eigen::Vector3d>& usable_map) const;
   void MergeLines();
   // The join cost of the pair (LaneJoinCost), or -1; `at_end` (the end of the drive) also
-  // with `*hidden` true when it passes only as a gap no frame saw, bridged along the driven
-  // path (lanes.join_max_hidden_gap_m, lane_path_bridge.h): the offsets' disagreement in
-  // combined floor sigmas. Such a bridge is measured by no pixel: joined online, the windows
-  // that later solve the rest of the lane moved curvy's extrinsic rotation 0.090 -> 0.099
-  // deg (docs/backend.md), so it is laid only when no window follows.
+  // when it passes only as a gap no frame saw, bridged along the driven path
+  // (lanes.join_max_hidden_gap_m, lane_path_bridge.h): the offsets' disagreement in combined
+  // floor sigmas, with that bridge in `*hidden_bridge` (else it is reset). Such a bridge is
+  // measured by no pixel: joined online, the windows that later solve the rest of the lane moved
+  // curvy's extrinsic rotation 0.090 -> 0.099 deg (docs/backend.md), so it is laid only when no
+  // window follows.
   double JoinCost(const LaneElement& first, const LaneElement& second, bool at_end,
-                  bool* hidden) const;
+                  std::optional<PathBridge>* hidden_bridge) const;
   // The frames around the gap between the first's end and the second's start (GapFrameSpan),
   // and the path bridge over it (BridgeAlongPath), or nullopt.
   FrameSpan GapSpan(const LaneElement& first, const LaneElement& second) const;
