@@ -10,14 +10,15 @@
 #include <vector>
 
 #include "ipm_road_mapper/core/frontend/instance_extraction.h"
-#include "ipm_road_mapper/core/geometry/catmull_rom_spline.h"
 #include "ipm_road_mapper/core/geometry/ipm.h"
 #include "ipm_road_mapper/core/geometry/rigid_transform.h"
+#include "ipm_road_mapper/core/map/lane_samples.h"
 
 namespace ipm_road_mapper {
 namespace {
 
 const cv::Scalar kMapColor(0, 220, 0);         // green (BGR)
+const cv::Scalar kLaidColor(160, 160, 160);    // grey: a lane stretch no pixel measured
 const cv::Scalar kMeasuredColor(255, 0, 255);  // magenta
 const cv::Scalar kResidualColor(0, 255, 255);  // yellow
 constexpr double kMinDepthM = 0.5;             // closer points are not drawn
@@ -110,14 +111,16 @@ void DrawMarkings(const VectorMap& map, const FrameProjector& projector,
 void DrawLanes(const VectorMap& map, const FrameProjector& projector,
                const Eigen::Vector3d& vehicle, cv::Mat* canvas, std::vector<Polyline>* lanes) {
   for (const MapLane& lane : map.lanes) {
-    std::vector<Eigen::Vector3d> samples;
+    LaneSamples samples;
     try {
-      samples = CatmullRomSpline(lane.control_points_map).SampleByArcLength(kLaneSampleSpacingM);
+      samples =
+          SampleLane(lane.control_points_map, UnmeasuredPointFlags(lane), kLaneSampleSpacingM);
     } catch (const std::exception&) {
       continue;
     }
     Polyline line;
-    for (const Eigen::Vector3d& p : samples) {
+    for (std::size_t k = 0; k < samples.points.size(); ++k) {
+      const Eigen::Vector3d& p = samples.points[k];
       Eigen::Vector2d uv;
       if ((p - vehicle).head<2>().norm() > kMaxElementRangeM || !projector.Project(p, &uv)) {
         if (line.size() >= 2) lanes->push_back(line);
@@ -125,7 +128,8 @@ void DrawLanes(const VectorMap& map, const FrameProjector& projector,
         continue;
       }
       if (!line.empty()) {
-        cv::line(*canvas, ToCv(line.back()), ToCv(uv), kMapColor, Thickness(*canvas), cv::LINE_AA);
+        cv::line(*canvas, ToCv(line.back()), ToCv(uv),
+                 samples.unmeasured[k] ? kLaidColor : kMapColor, Thickness(*canvas), cv::LINE_AA);
       }
       line.push_back(uv);
     }

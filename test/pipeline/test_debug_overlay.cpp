@@ -118,6 +118,31 @@ TEST(DebugOverlay, LanePixelsMatchTheProjectedLane) {
   EXPECT_GT(stats.mean_lane_residual_px, 5.0);
 }
 
+// A lane stretch no pixel measured (laid by a join) is drawn grey, the rest green.
+TEST(DebugOverlay, ALaidLaneStretchIsDrawnGrey) {
+  const cv::Mat mask = test::EmptyMask();
+  const OverlayFrame frame = Frame(mask);
+  const FrameObservations measured =
+      MeasureFrame(mask, frame.camera, frame.T_base_cam, Classes(), Options());
+  VectorMap map;
+  map.lanes.push_back(StraightLane(-2.0));
+  OverlayStats stats;
+  const auto count = [](const cv::Mat& image, const cv::Scalar& bgr) {
+    cv::Mat hits;
+    cv::inRange(image, bgr, bgr, hits);
+    return cv::countNonZero(hits);
+  };
+  const cv::Scalar green(0, 220, 0), grey(160, 160, 160);
+  const cv::Mat measured_lane = DrawDebugOverlay(frame, measured, map, &stats);
+  EXPECT_GT(count(measured_lane, green), 100);
+  EXPECT_EQ(count(measured_lane, grey), 0);
+  map.lanes[0].unmeasured = {{4, 6}};  // x 12-18 m: the curve from 9 to 21 m is laid
+  const cv::Mat laid = DrawDebugOverlay(frame, measured, map, &stats);
+  EXPECT_GT(count(laid, grey), 50);
+  EXPECT_GT(count(laid, green), 50);
+  EXPECT_LT(count(laid, green), count(measured_lane, green));
+}
+
 TEST(DebugOverlay, BadInputGivesAnImageNotACrash) {
   OverlayFrame frame = Frame(test::EmptyMask());
   OverlayStats stats;
