@@ -143,7 +143,9 @@ TEST(MarkerBuilder, ALaneStretchNoPixelMeasuredIsDrawnGrey) {
     for (std::size_t i = 0; i < m.points.size(); ++i) {
       const double x = m.points[i].x;
       const bool grey = m.colors[i].r == m.colors[i].g && m.colors[i].a < 1.0f;
-      if (x > 12.1 && x < 17.9) EXPECT_TRUE(grey) << x;
+      if (x > 12.1 && x < 17.9) {
+        EXPECT_TRUE(grey) << x;
+      }
       if (x < 11.9 || x > 18.1) {
         EXPECT_FALSE(grey) << x;
         EXPECT_EQ(m.colors[i].a, m.color.a) << x;
