@@ -3,8 +3,9 @@
 # build folder): a map of three parallel lines (the test bag's mapped line and two copies 3.5 m
 # either side) exported by export_map loads with no error, gives two lanelets that are each
 # other's neighbours in Lanelet2's routing graph (lane change allowed over the dashed middle
-# line only), a graph without validity errors, and points at their map-frame metres under
-# LocalCartesianProjector. Without the wheel (no network, no pip, another Python) the test
+# line only), a graph without validity errors, points at their map-frame metres under
+# LocalCartesianProjector, and the points of a stretch a join laid (map.json `unmeasured`)
+# with the attribute irm:measured = no, on that line only. Without the wheel (no network, no pip, another Python) the test
 # exits 77: skipped.
 set -eo pipefail
 export PATH="/usr/bin:/bin:$PATH"
@@ -54,6 +55,9 @@ for k, dy in ((1, -3.5), (2, 3.5)):
     lane["style"] = "solid"
     lane["control_points"] = [[p[0], p[1] + dy, p[2]] for p in middle["control_points"]]
     lanes.append(lane)
+# The right line's control points 3-4 laid by a join: no pixel measured them.
+assert len(lanes[1]["control_points"]) >= 8, len(lanes[1]["control_points"])
+lanes[1]["unmeasured"] = [[3, 4]]
 m["lanes"] = lanes
 json.dump(m, open(sys.argv[2], "w"))
 PY
@@ -79,7 +83,14 @@ assert {graph.left(a).id if graph.left(a) else None, graph.right(a).id if graph.
     "the two lanelets are not lane-change neighbours over the dashed line"
 for p in m.pointLayer:
     assert abs(p.x - float(p.attributes["local_x"])) < 2e-3 and abs(p.y - float(p.attributes["local_y"])) < 2e-3, p
+# The laid stretch's points carry irm:measured = no, on the right line only.
+laid = [p for p in m.pointLayer if "irm:measured" in p.attributes]
+assert laid, "no point of the laid stretch carries irm:measured"
+assert all(p.attributes["irm:measured"] == "no" for p in laid)
+on_right = {p.id for ls in m.lineStringLayer
+            if "irm:id" in ls.attributes and ls.attributes["irm:id"] == "1001" for p in ls}
+assert {p.id for p in laid} <= on_right, "a laid point off the line the join laid"
 print("ok: lanelet2 loads map.osm: 2 lanelets, neighbours over the dashed line, routing graph valid, "
-      "%d points at their map-frame metres" % len(m.pointLayer))
+      "%d points at their map-frame metres, %d of the laid stretch flagged" % (len(m.pointLayer), len(laid)))
 PY
 echo "lanelet2 load: all checks passed"
