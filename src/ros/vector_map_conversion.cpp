@@ -2,6 +2,7 @@
 
 #include <algorithm>
 
+#include "ipm_road_mapper/core/map/lane_samples.h"
 #include "ipm_road_mapper/ros/msg_conversion.h"
 
 namespace ipm_road_mapper {
@@ -13,33 +14,22 @@ ros::Time SafeTime(double seconds) {
   return FromSeconds(seconds);
 }
 
-// The lane's unmeasured flags for its control points from `from` on: empty when none is.
+// The lane's unmeasured flags for its control points from `from` on (the messages' per-point
+// flags): empty when none is.
 std::vector<std::uint8_t> UnmeasuredFlags(const MapLane& lane, std::size_t from) {
-  const std::size_t count = lane.control_points_map.size();
-  std::vector<std::uint8_t> flags;
-  for (const auto& [first, last] : lane.unmeasured) {
-    if (last < from || first >= count) continue;
-    flags.resize(count - from, 0);
-    for (std::size_t i = std::max(first, from); i <= std::min(last, count - 1); ++i) {
-      flags[i - from] = 1;
-    }
-  }
-  return flags;
+  const std::vector<bool> points = UnmeasuredPointFlags(lane);
+  from = std::min(from, points.size());
+  if (std::find(points.begin() + from, points.end(), true) == points.end()) return {};
+  return std::vector<std::uint8_t>(points.begin() + from, points.end());
 }
 
 }  // namespace
 
-void AddUnmeasuredFlags(const std::vector<std::uint8_t>& flags, std::size_t first_index,
+void SetUnmeasuredFlags(const std::vector<std::uint8_t>& flags, std::size_t first_index,
                         MapLane* lane) {
-  for (std::size_t i = 0; i < flags.size(); ++i) {
-    if (flags[i] == 0) continue;
-    const std::size_t index = first_index + i;
-    if (!lane->unmeasured.empty() && lane->unmeasured.back().second + 1 == index) {
-      lane->unmeasured.back().second = index;
-    } else {
-      lane->unmeasured.emplace_back(index, index);
-    }
-  }
+  std::vector<bool> set(flags.size());
+  for (std::size_t i = 0; i < flags.size(); ++i) set[i] = flags[i] != 0;
+  SetUnmeasuredFrom(first_index, set, lane);
 }
 
 ipm_road_mapper::MarkingPolygon ToMarkingMsg(const MapMarking& marking) {
@@ -133,7 +123,7 @@ VectorMap FromVectorMapMsg(const ipm_road_mapper::VectorMapMsg& msg) {
     lane.class_name = l.class_name;
     lane.style = l.style == "unknown" ? "" : l.style;
     for (const auto& c : l.control_points) lane.control_points_map.push_back(FromPointMsg(c));
-    if (l.unmeasured.size() == l.control_points.size()) AddUnmeasuredFlags(l.unmeasured, 0, &lane);
+    if (l.unmeasured.size() == l.control_points.size()) SetUnmeasuredFlags(l.unmeasured, 0, &lane);
     lane.observations = l.observations;
     lane.first_seen = ToSeconds(l.first_seen);
     lane.last_seen = ToSeconds(l.last_seen);

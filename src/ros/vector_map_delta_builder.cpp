@@ -194,13 +194,11 @@ void ApplyVectorMapDelta(const ipm_road_mapper::VectorMapDelta& delta, VectorMap
         std::min<std::size_t>(patch.first_index, lane.control_points_map.size());
     lane.control_points_map.resize(keep);
     for (const auto& p : patch.control_points) lane.control_points_map.push_back(FromPointMsg(p));
-    // The unmeasured flags of the points kept, then the patch's.
-    auto& ranges = lane.unmeasured;
-    while (!ranges.empty() && ranges.back().first >= keep) ranges.pop_back();
-    if (!ranges.empty() && ranges.back().second >= keep) ranges.back().second = keep - 1;
-    if (patch.unmeasured.size() == patch.control_points.size()) {
-      AddUnmeasuredFlags(patch.unmeasured, keep, &lane);
-    }
+    // The unmeasured flags of the points kept, then the patch's (none when it has none).
+    SetUnmeasuredFlags(patch.unmeasured.size() == patch.control_points.size()
+                           ? patch.unmeasured
+                           : std::vector<std::uint8_t>(),
+                       keep, &lane);
     lane.observations = patch.observations;
     lane.first_seen = ToSeconds(patch.first_seen);
     lane.last_seen = ToSeconds(patch.last_seen);

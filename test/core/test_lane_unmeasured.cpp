@@ -6,6 +6,7 @@
 #include <random>
 
 #include "common/lane_fragments.h"
+#include "ipm_road_mapper/core/map/index_ranges.h"
 #include "ipm_road_mapper/core/mapper/lane_join.h"
 #include "ipm_road_mapper/core/mapper/lane_unmeasured.h"
 
@@ -20,9 +21,9 @@ test::Line Straight() {
 }
 
 TEST(LaneUnmeasured, RangesOfFlagsAreMaximalRuns) {
-  EXPECT_TRUE(RangesOf({}, 0).empty());
-  EXPECT_TRUE(RangesOf({false, false}, 3).empty());
-  EXPECT_EQ(RangesOf({true, true, false, true, false, true, true, true}, -2),
+  EXPECT_TRUE(RangesOfFlags<std::int64_t>({}, 0).empty());
+  EXPECT_TRUE(RangesOfFlags<std::int64_t>({false, false}, 3).empty());
+  EXPECT_EQ(RangesOfFlags<std::int64_t>({true, true, false, true, false, true, true, true}, -2),
             (Ranges{{-2, -1}, {1, 1}, {3, 5}}));
 }
 

@@ -25,9 +25,9 @@ ipm_road_mapper::LaneSpline ToLaneMsg(const MapLane& lane);
 ipm_road_mapper::LaneSplinePatch ToLanePatchMsg(const MapLane& lane, std::size_t from);
 
 // Per-point unmeasured flags (LaneSpline / LaneSplinePatch `unmeasured`, the first at
-// control point `first_index`) appended to `lane`'s ranges (MapLane::unmeasured); the lane's
-// ranges must end before first_index.
-void AddUnmeasuredFlags(const std::vector<std::uint8_t>& flags, std::size_t first_index,
+// control point `first_index`) as `lane`'s ranges from there on (SetUnmeasuredFrom): the
+// ranges before first_index stay, those after are replaced.
+void SetUnmeasuredFlags(const std::vector<std::uint8_t>& flags, std::size_t first_index,
                         MapLane* lane);
 
 // VectorMap -> message in `frame_id` at `stamp`: markings (4 corners), lanes (control points,

@@ -193,9 +193,9 @@ std::string VectorMapToLanelet2Osm(const VectorMap& map, const GeoOrigin& origin
     std::vector<Eigen::Vector3d> polyline = LanePolyline(lane, kLaneSampleSpacing_m, &flags);
     if (polyline.size() < 2) continue;
     lanes.push_back(&lane);
-    const Eigen::Vector3d front = polyline.front();
-    lines.push_back(LaneOrientedAlongDrive(std::move(polyline), map.trajectory));
-    if (lines.back().front() != front) std::reverse(flags.begin(), flags.end());
+    bool reversed = false;
+    lines.push_back(LaneOrientedAlongDrive(std::move(polyline), map.trajectory, &reversed));
+    if (reversed) std::reverse(flags.begin(), flags.end());
     unmeasured.push_back(std::move(flags));
   }
   const LaneletLayout layout = PairLanelets(lines);

@@ -3,6 +3,7 @@
 #include <stdexcept>
 
 #include "ipm_road_mapper/core/geometry/catmull_rom_spline.h"
+#include "ipm_road_mapper/core/map/index_ranges.h"
 
 namespace ipm_road_mapper {
 
@@ -13,6 +14,21 @@ std::vector<bool> UnmeasuredPointFlags(const MapLane& lane) {
     for (std::size_t i = first; i <= last && i < n; ++i) flags[i] = true;
   }
   return flags;
+}
+
+void SetUnmeasuredFrom(std::size_t first_index, const std::vector<bool>& flags, MapLane* lane) {
+  auto& ranges = lane->unmeasured;
+  while (!ranges.empty() && ranges.back().first >= first_index) ranges.pop_back();
+  if (!ranges.empty() && ranges.back().second >= first_index) {
+    ranges.back().second = first_index - 1;  // first_index > ranges.back().first >= 0
+  }
+  for (const auto& range : RangesOfFlags(flags, first_index)) {
+    if (!ranges.empty() && ranges.back().second + 1 == range.first) {
+      ranges.back().second = range.second;
+    } else {
+      ranges.push_back(range);
+    }
+  }
 }
 
 LaneSamples SampleLane(const std::vector<Eigen::Vector3d>& control_points,

@@ -199,7 +199,9 @@ Eigen::Vector3d PointAtArcLength(const std::vector<Eigen::Vector3d>& polyline,
 }
 
 std::vector<Eigen::Vector3d> LaneOrientedAlongDrive(std::vector<Eigen::Vector3d> polyline,
-                                                    const std::vector<StampedPose>& trajectory) {
+                                                    const std::vector<StampedPose>& trajectory,
+                                                    bool* reversed) {
+  if (reversed) *reversed = false;
   if (polyline.size() < 2 || trajectory.empty()) return polyline;
   const std::size_t middle = polyline.size() / 2;
   const Eigen::Vector2d p = polyline[middle].head<2>();
@@ -215,6 +217,7 @@ std::vector<Eigen::Vector3d> LaneOrientedAlongDrive(std::vector<Eigen::Vector3d>
   const Eigen::Vector2d heading = nearest->T_map_base.linear().col(0).head<2>();
   if (DirectionAt(polyline, middle).dot(heading) < 0.0) {
     std::reverse(polyline.begin(), polyline.end());
+    if (reversed) *reversed = true;
   }
   return polyline;
 }

@@ -8,7 +8,9 @@
 
 #include "ipm_road_mapper/core/geometry/catmull_rom_spline.h"
 #include "ipm_road_mapper/core/geometry/principal_axis.h"
+#include "ipm_road_mapper/core/map/index_ranges.h"
 #include "ipm_road_mapper/core/mapper/lane_unmeasured.h"
+#include "ipm_road_mapper/core/mapper/shared_frames.h"
 
 namespace ipm_road_mapper {
 namespace {
@@ -240,7 +242,7 @@ LaneElement Joined(const LaneElement& first, const LaneElement& second,
                    std::vector<Eigen::Vector3d> cps, const std::vector<bool>& unmeasured) {
   LaneElement joined = first;
   joined.control_points_map = std::move(cps);
-  joined.unmeasured_cps = RangesOf(unmeasured, first.first_cp_index);
+  joined.unmeasured_cps = RangesOfFlags(unmeasured, first.first_cp_index);
   MergeObservations(second, &joined);
   joined.optimized = first.optimized || second.optimized;
   joined.retired_before_frame = std::min(first.retired_before_frame, second.retired_before_frame);
@@ -310,21 +312,9 @@ bool TwoLinesInOneFrame(const std::vector<Eigen::Vector3d>& a,
 }  // namespace
 
 bool CoObserved(const LaneElement& a, const LaneElement& b) {
-  // A merge walk over the two histories (sorted by frame), each shared frame's points compared.
-  auto i = a.history.begin();
-  auto j = b.history.begin();
-  while (i != a.history.end() && j != b.history.end()) {
-    if (i->frame_index == j->frame_index) {
-      if (TwoLinesInOneFrame(i->selected_map, j->selected_map)) return true;
-      ++i;
-      ++j;
-    } else if (i->frame_index < j->frame_index) {
-      ++i;
-    } else {
-      ++j;
-    }
-  }
-  return false;
+  return AnySharedFrame(a, b, [](const LaneMeasurement& ma, const LaneMeasurement& mb) {
+    return TwoLinesInOneFrame(ma.selected_map, mb.selected_map);
+  });
 }
 
 bool LaneContinues(const LaneElement& first, const LaneElement& second, const LaneJoinOptions& join,

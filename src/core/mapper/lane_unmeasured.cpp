@@ -12,20 +12,6 @@ bool ControlPointUnmeasured(const LaneElement& lane, std::size_t local) {
   return false;
 }
 
-std::vector<IndexRange> RangesOf(const std::vector<bool>& flags, std::int64_t first_index) {
-  std::vector<IndexRange> ranges;
-  for (std::size_t i = 0; i < flags.size(); ++i) {
-    if (!flags[i]) continue;
-    const std::int64_t index = first_index + static_cast<std::int64_t>(i);
-    if (!ranges.empty() && ranges.back().second + 1 == index) {
-      ranges.back().second = index;
-    } else {
-      ranges.emplace_back(index, index);
-    }
-  }
-  return ranges;
-}
-
 std::vector<std::pair<std::size_t, std::size_t>> ExportedUnmeasured(const LaneElement& lane,
                                                                     std::size_t from,
                                                                     std::size_t count) {

@@ -6,6 +6,7 @@
 #pragma once
 
 #include <Eigen/Core>
+#include <cstddef>
 #include <vector>
 
 #include "ipm_road_mapper/core/map/vector_map.h"
@@ -19,6 +20,10 @@ struct LaneSamples {
 
 // Per control point of `lane`: whether it is in one of its unmeasured ranges.
 std::vector<bool> UnmeasuredPointFlags(const MapLane& lane);
+
+// `lane`'s unmeasured ranges with those of its points from `first_index` on replaced by
+// `flags` (one per point from there; a patch of the lane's tail).
+void SetUnmeasuredFrom(std::size_t first_index, const std::vector<bool>& flags, MapLane* lane);
 
 // The curve of `control_points` (at least 4, phantom ends included) sampled every spacing_m,
 // with `point_unmeasured` per control point. Throws std::invalid_argument as CatmullRomSpline

@@ -59,9 +59,10 @@ struct LaneletLayout {
 
 // The polyline reversed when the drive went the other way along it: its direction at the
 // sample nearest to the trajectory's poses (the nearest pose to its middle sample) against
-// that pose's heading. Unchanged without a trajectory.
+// that pose's heading. Unchanged without a trajectory. With `reversed`, whether it was.
 std::vector<Eigen::Vector3d> LaneOrientedAlongDrive(std::vector<Eigen::Vector3d> polyline,
-                                                    const std::vector<StampedPose>& trajectory);
+                                                    const std::vector<StampedPose>& trajectory,
+                                                    bool* reversed = nullptr);
 
 // The lanelets between `lines` (oriented polylines, map frame; see the file comment).
 LaneletLayout PairLanelets(const std::vector<std::vector<Eigen::Vector3d>>& lines);

@@ -26,9 +26,6 @@ using IndexRange = std::pair<std::int64_t, std::int64_t>;  // inclusive
 // Whether `lane`'s control point at `local` (an index into control_points_map) is unmeasured.
 bool ControlPointUnmeasured(const LaneElement& lane, std::size_t local);
 
-// The inclusive ranges of the set flags, the first flag at index `first_index`.
-std::vector<IndexRange> RangesOf(const std::vector<bool>& flags, std::int64_t first_index);
-
 // The lane's unmeasured control points among `count` exported ones, control_points_map's
 // from local index `from` on: inclusive ranges of exported indices (0 = local `from`).
 std::vector<std::pair<std::size_t, std::size_t>> ExportedUnmeasured(const LaneElement& lane,
