@@ -400,14 +400,13 @@ def print_ablation_tables(scenarios, results, extra):
     # What a perfect calibration would give: the same method with the true extrinsic held
     # (not refined). A figure the held run cannot reach is beyond what calibration can fix on
     # that drive; "closed" is the marking APE over the markings the map calls complete.
+    paired = ("marking_ape_mean_m", "marking_ape_complete_mean_m", "lane_ape_mean_m",
+              "pose_trans_err_m")
     rows = []
     for s in scenarios:
         m, h = results[(s, "ours_ppsr")], results[(s, "true_extrinsic_held")]
-        rows.append([s, fmt(m.get("marking_ape_mean_m")), fmt(h.get("marking_ape_mean_m")),
-                     fmt(m.get("marking_ape_complete_mean_m")),
-                     fmt(h.get("marking_ape_complete_mean_m")), fmt(m.get("lane_ape_mean_m")),
-                     fmt(h.get("lane_ape_mean_m")), fmt(m.get("pose_trans_err_m")),
-                     fmt(h.get("pose_trans_err_m")), fmt(m.get("pose_trans_err_m_input"))])
+        rows.append([s] + [fmt(r.get(key)) for key in paired for r in (m, h)] +
+                    [fmt(m.get("pose_trans_err_m_input"))])
     table("Table 3c. What calibration limits (Ours +PPSR): from the rough extrinsic (refined) vs "
           "with the true extrinsic held",
           ["scenario", "marking APE", "held true: marking APE", "closed markings APE",

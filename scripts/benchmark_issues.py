@@ -109,10 +109,13 @@ def print_tables(scenarios, results, table, fmt, real_absent=False):
               "drive", "laid / mapped length (m)", "lane APE laid (m)", "lane APE measured (m)"],
           rows)
 
-    def held(d, key):
-        """' (true extrinsic held: x)': the figure a perfect calibration gives (Table 3c)."""
+    def held(d, key, what=""):
+        """' (<what>with the true extrinsic held: x)': the figure a perfect calibration gives
+        (Table 3c)."""
         h = results.get((d, "true_extrinsic_held"))
-        return "" if h is None or h.get(key) is None else " (true extrinsic held: %s)" % fmt(h[key])
+        if h is None or h.get(key) is None:
+            return ""
+        return " (%swith the true extrinsic held: %s)" % (what, fmt(h[key]))
 
     def ceiling(m, reachable_key, total_key):
         """' (view ceiling r / n)' when the drive's view caps the figure below its total."""
@@ -247,8 +250,7 @@ def print_tables(scenarios, results, table, fmt, real_absent=False):
         m = ours(REAL)
         rows.append([REAL, "rotation (deg) / IPM grid (m) / pose error (m)", "%s / %s / %s%s" % (
             fmt(m.get("extrinsic_rot_err_deg")), fmt(m.get("ipm_grid_err_m")),
-            fmt(m.get("pose_trans_err_m")), held(REAL, "pose_trans_err_m").replace(
-                "true extrinsic held", "pose with the true extrinsic held")),
+            fmt(m.get("pose_trans_err_m")), held(REAL, "pose_trans_err_m", "pose ")),
             "<= 0.30 / <= 0.30 / <= 0.12"])
     rows.append(["live nodelet", "~corrected_odom error vs input",
                  "rostest test_mapper_poses.py (bound 0.62x)",
