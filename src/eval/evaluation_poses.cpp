@@ -109,6 +109,65 @@ void EvaluateCalibrationConsistency(const VectorMap& map, const Eigen::Isometry3
   m->nees_dof = n;
 }
 
+// GT frame indices sorted by stamp.
+std::vector<int> FramesByStamp(const GroundTruth& gt) {
+  std::vector<int> order(gt.frames.size());
+  for (std::size_t i = 0; i < order.size(); ++i) order[i] = static_cast<int>(i);
+  std::sort(order.begin(), order.end(),
+            [&](int a, int b) { return gt.frames[a].stamp < gt.frames[b].stamp; });
+  return order;
+}
+
+// Per GT frame: whether its true speed (from its neighbours in time, one-sided at the ends)
+// is at least `min_speed_mps`. A lone frame does not move.
+std::vector<bool> MovingFrames(const GroundTruth& gt, const std::vector<int>& order,
+                               double min_speed_mps) {
+  std::vector<bool> moving(gt.frames.size(), false);
+  const int n = static_cast<int>(order.size());
+  for (int k = 0; k < n; ++k) {
+    const GroundTruthFrame& a = gt.frames[order[std::max(0, k - 1)]];
+    const GroundTruthFrame& b = gt.frames[order[std::min(n - 1, k + 1)]];
+    const double dt = b.stamp - a.stamp;
+    if (dt <= 0.0) continue;
+    const double distance_m =
+        (b.T_map_base_true.translation() - a.T_map_base_true.translation()).norm();
+    moving[order[k]] = distance_m >= min_speed_mps * dt;
+  }
+  return moving;
+}
+
+// Pairs (GT frame, corrected pose or nullptr): the map's poses matched by stamp (those
+// without a GT frame counted in *unmatched), or every GT frame when the map has no
+// trajectory (then only the odometry is measured). `order`: FramesByStamp(gt).
+std::vector<std::pair<int, const StampedPose*>> PairPoses(const VectorMap& map,
+                                                          const GroundTruth& gt,
+                                                          const std::vector<int>& order,
+                                                          const EvaluationOptions& options,
+                                                          int* unmatched) {
+  std::vector<std::pair<int, const StampedPose*>> pairs;
+  if (map.trajectory.empty()) {
+    for (std::size_t i = 0; i < gt.frames.size(); ++i) {
+      pairs.emplace_back(static_cast<int>(i), nullptr);
+    }
+    return pairs;
+  }
+  for (const StampedPose& pose : map.trajectory) {
+    const int frame = NearestFrame(gt, order, pose.stamp, options.pose_stamp_tolerance_s);
+    if (frame < 0) {
+      ++*unmatched;
+    } else {
+      pairs.emplace_back(frame, &pose);
+    }
+  }
+  return pairs;
+}
+
+// The translation error in the true base_link axes: x along the heading, y across it.
+Eigen::Vector3d InBase(const Eigen::Isometry3d& T_est, const Eigen::Isometry3d& T_true) {
+  return Eigen::Vector3d(T_true.linear().transpose() *
+                         (T_est.translation() - T_true.translation()));
+}
+
 }  // namespace
 
 ExtrinsicMetrics EvaluateExtrinsic(const VectorMap& map, const GroundTruth& gt,
@@ -121,6 +180,8 @@ ExtrinsicMetrics EvaluateExtrinsic(const VectorMap& map, const GroundTruth& gt,
   m.rpy_err_deg_initial = RpyErrorDeg(map.T_base_cam_initial, T_true);
   m.trans_err_xyz_m = map.T_base_cam.translation() - T_true.translation();
   m.trans_err_xyz_m_initial = map.T_base_cam_initial.translation() - T_true.translation();
+  m.true_xyz_m = T_true.translation();
+  m.true_rpy_deg = RpyFromRotation(T_true.linear()) * kRadToDeg;
   m.trans_err_m = m.trans_err_xyz_m.norm();
   m.trans_err_m_initial = m.trans_err_xyz_m_initial.norm();
   int pixels_initial = 0;
@@ -136,39 +197,18 @@ PoseMetrics EvaluatePoses(const VectorMap& map, const GroundTruth& gt,
                           const EvaluationOptions& options) {
   PoseMetrics metrics;
   metrics.has_trajectory = !map.trajectory.empty();
-  // Pairs (GT frame, corrected pose or nullptr): the map's poses matched by stamp, or every
-  // GT frame when the map has no trajectory (then only the odometry is measured).
-  std::vector<std::pair<int, const StampedPose*>> pairs;
-  if (metrics.has_trajectory) {
-    std::vector<int> order(gt.frames.size());
-    for (std::size_t i = 0; i < order.size(); ++i) order[i] = static_cast<int>(i);
-    std::sort(order.begin(), order.end(),
-              [&](int a, int b) { return gt.frames[a].stamp < gt.frames[b].stamp; });
-    for (const StampedPose& pose : map.trajectory) {
-      const int frame = NearestFrame(gt, order, pose.stamp, options.pose_stamp_tolerance_s);
-      if (frame < 0) {
-        ++metrics.map_poses_unmatched;
-      } else {
-        pairs.emplace_back(frame, &pose);
-      }
-    }
-  } else {
-    for (std::size_t i = 0; i < gt.frames.size(); ++i) {
-      pairs.emplace_back(static_cast<int>(i), nullptr);
-    }
-  }
+  const std::vector<int> order = FramesByStamp(gt);
+  const std::vector<bool> moving = MovingFrames(gt, order, options.pose_moving_min_speed_mps);
+  const std::vector<std::pair<int, const StampedPose*>> pairs =
+      PairPoses(map, gt, order, options, &metrics.map_poses_unmatched);
 
   std::vector<double> trans, rot, yaw, trans_input, rot_input, yaw_input;
-  std::vector<double> along, across, along_input, across_input;
-  // The translation error in the true base_link axes: x along the heading, y across it.
-  auto in_base = [](const Eigen::Isometry3d& T_est, const Eigen::Isometry3d& T_true) {
-    return Eigen::Vector3d(T_true.linear().transpose() *
-                           (T_est.translation() - T_true.translation()));
-  };
+  std::vector<double> along, across, along_input, across_input, moving_trans, moving_input;
   for (const auto& [frame_index, pose] : pairs) {
     const GroundTruthFrame& frame = gt.frames[frame_index];
     PoseFrameError e;
     e.stamp = frame.stamp;
+    e.moving = moving[frame_index];
     e.trans_err_m_input =
         (frame.T_map_base_odom.translation() - frame.T_map_base_true.translation()).norm();
     e.rot_err_deg_input =
@@ -177,7 +217,8 @@ PoseMetrics EvaluatePoses(const VectorMap& map, const GroundTruth& gt,
     trans_input.push_back(e.trans_err_m_input);
     rot_input.push_back(e.rot_err_deg_input);
     yaw_input.push_back(e.yaw_err_deg_input);
-    const Eigen::Vector3d e_input = in_base(frame.T_map_base_odom, frame.T_map_base_true);
+    if (e.moving) moving_input.push_back(e.trans_err_m_input);
+    const Eigen::Vector3d e_input = InBase(frame.T_map_base_odom, frame.T_map_base_true);
     along_input.push_back(std::abs(e_input.x()));
     across_input.push_back(std::abs(e_input.y()));
     if (pose == nullptr) {
@@ -189,13 +230,15 @@ PoseMetrics EvaluatePoses(const VectorMap& map, const GroundTruth& gt,
       trans.push_back(e.trans_err_m);
       rot.push_back(e.rot_err_deg);
       yaw.push_back(e.yaw_err_deg);
-      const Eigen::Vector3d e_base = in_base(pose->T_map_base, frame.T_map_base_true);
+      if (e.moving) moving_trans.push_back(e.trans_err_m);
+      const Eigen::Vector3d e_base = InBase(pose->T_map_base, frame.T_map_base_true);
       along.push_back(std::abs(e_base.x()));
       across.push_back(std::abs(e_base.y()));
     }
     metrics.frames.push_back(e);
   }
   metrics.frames_matched = metrics.has_trajectory ? static_cast<int>(pairs.size()) : 0;
+  metrics.frames_moving = static_cast<int>(moving_input.size());
   metrics.trans_err_m = Summarize(std::move(trans));
   metrics.rot_err_deg = Summarize(std::move(rot));
   metrics.yaw_err_deg = Summarize(std::move(yaw));
@@ -206,6 +249,8 @@ PoseMetrics EvaluatePoses(const VectorMap& map, const GroundTruth& gt,
   metrics.across_err_m = Summarize(std::move(across));
   metrics.along_err_m_input = Summarize(std::move(along_input));
   metrics.across_err_m_input = Summarize(std::move(across_input));
+  metrics.trans_err_moving_m = Summarize(std::move(moving_trans));
+  metrics.trans_err_moving_m_input = Summarize(std::move(moving_input));
   return metrics;
 }
 

@@ -184,6 +184,8 @@ void AddExtrinsic(const ExtrinsicMetrics& m, nlohmann::json* j) {
   (*j)["extrinsic_rpy_err_deg_initial"] = Vector(m.rpy_err_deg_initial);
   (*j)["extrinsic_trans_err_xyz_m"] = Vector(m.trans_err_xyz_m);
   (*j)["extrinsic_trans_err_xyz_m_initial"] = Vector(m.trans_err_xyz_m_initial);
+  (*j)["extrinsic_true_xyz_m"] = Vector(m.true_xyz_m);
+  (*j)["extrinsic_true_rpy_deg"] = Vector(m.true_rpy_deg);
   (*j)["ipm_grid_err_m"] = Number(m.ipm_grid_err_m.mean);
   (*j)["ipm_grid_err_m_initial"] = Number(m.ipm_grid_err_m_initial.mean);
   (*j)["ipm_grid_err_max_m"] = Number(m.ipm_grid_err_m.max);
@@ -214,6 +216,9 @@ void AddPoses(const PoseMetrics& m, nlohmann::json* j) {
   (*j)["pose_across_err_m"] = Number(m.across_err_m.mean);
   (*j)["pose_along_err_m_input"] = Number(m.along_err_m_input.mean);
   (*j)["pose_across_err_m_input"] = Number(m.across_err_m_input.mean);
+  (*j)["pose_frames_moving"] = m.frames_moving;
+  (*j)["pose_trans_err_moving_m"] = Number(m.trans_err_moving_m.mean);
+  (*j)["pose_trans_err_moving_m_input"] = Number(m.trans_err_moving_m_input.mean);
   nlohmann::json frames = nlohmann::json::array();
   for (const PoseFrameError& e : m.frames) {
     frames.push_back({{"stamp", e.stamp},
@@ -222,7 +227,8 @@ void AddPoses(const PoseMetrics& m, nlohmann::json* j) {
                       {"yaw_err_deg", Number(e.yaw_err_deg)},
                       {"trans_err_m_input", e.trans_err_m_input},
                       {"rot_err_deg_input", e.rot_err_deg_input},
-                      {"yaw_err_deg_input", e.yaw_err_deg_input}});
+                      {"yaw_err_deg_input", e.yaw_err_deg_input},
+                      {"moving", e.moving}});
   }
   (*j)["poses"] = frames;
 }
@@ -235,6 +241,7 @@ nlohmann::json OptionsToJson(const EvaluationOptions& o) {
           {"lane_cover_min_length_m", o.lane_cover_min_length_m},
           {"lane_max_link_m", o.lane_max_link_m},
           {"pose_stamp_tolerance_s", o.pose_stamp_tolerance_s},
+          {"pose_moving_min_speed_mps", o.pose_moving_min_speed_mps},
           {"ipm_grid_step_px", o.ipm_grid_step_px},
           {"ipm_grid_min_ahead_m", o.ipm_grid_min_ahead_m},
           {"ipm_grid_max_ahead_m", o.ipm_grid_max_ahead_m},

@@ -162,6 +162,8 @@ void AddPoseRows(const Metrics& metrics, Table* t) {
          "m");
   t->Row("  across the heading", Fixed(p.across_err_m.mean, 3), Fixed(p.across_err_m_input.mean, 3),
          "m");
+  t->Row("translation error mean, " + std::to_string(p.frames_moving) + " moving frames",
+         Fixed(p.trans_err_moving_m.mean, 3), Fixed(p.trans_err_moving_m_input.mean, 3), "m");
   t->Row("rotation error mean", Fixed(p.rot_err_deg.mean, 3), Fixed(p.rot_err_deg_input.mean, 3),
          "deg");
   t->Row("yaw error mean", Fixed(p.yaw_err_deg.mean, 3), Fixed(p.yaw_err_deg_input.mean, 3), "deg");

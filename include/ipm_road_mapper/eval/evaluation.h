@@ -18,17 +18,18 @@ namespace ipm_road_mapper {
 
 // Gates and sampling of the evaluation; the defaults are the project's benchmark settings.
 struct EvaluationOptions {
-  double marking_gate_m = 2.0;           // largest center distance of a marking match
-  double lane_sample_spacing_m = 0.1;    // arc-length spacing of mapped-spline samples
-  double lane_match_distance_m = 0.5;    // a point this close to a lane lies "on" it
-  double lane_match_fraction = 0.75;     // share of points on the other side for a lane match
-  double lane_cover_min_length_m = 1.0;  // spline length on a GT lane to count as covering it
-  double lane_max_link_m = 1.0;          // lane points farther apart are not joined by a line
-  double pose_stamp_tolerance_s = 1e-3;  // map pose <-> GT frame stamp association
-  int ipm_grid_step_px = 40;             // pixel grid spacing of the IPM error
-  double ipm_grid_min_ahead_m = 5.0;     // grid pixels whose true ground point is this far
-  double ipm_grid_max_ahead_m = 30.0;    //   ahead (base_link x) are used
-  std::int64_t map_bytes = -1;           // size of the map file; < 0: size of the serialized map
+  double marking_gate_m = 2.0;             // largest center distance of a marking match
+  double lane_sample_spacing_m = 0.1;      // arc-length spacing of mapped-spline samples
+  double lane_match_distance_m = 0.5;      // a point this close to a lane lies "on" it
+  double lane_match_fraction = 0.75;       // share of points on the other side for a lane match
+  double lane_cover_min_length_m = 1.0;    // spline length on a GT lane to count as covering it
+  double lane_max_link_m = 1.0;            // lane points farther apart are not joined by a line
+  double pose_stamp_tolerance_s = 1e-3;    // map pose <-> GT frame stamp association
+  double pose_moving_min_speed_mps = 0.5;  // a GT frame moves at this true speed or faster
+  int ipm_grid_step_px = 40;               // pixel grid spacing of the IPM error
+  double ipm_grid_min_ahead_m = 5.0;       // grid pixels whose true ground point is this far
+  double ipm_grid_max_ahead_m = 30.0;      //   ahead (base_link x) are used
+  std::int64_t map_bytes = -1;             // size of the map file; < 0: size of the serialized map
   // Most mapped-spline samples over all lanes (100 km at 0.1 m, about 1.5 s of sampling and
   // queries); a map needing more is refused with a MapFormatError before any sampling.
   double max_lane_samples = 1e6;
@@ -180,6 +181,10 @@ struct ExtrinsicMetrics {
   Eigen::Vector3d rpy_err_deg_initial = Eigen::Vector3d::Zero();
   Eigen::Vector3d trans_err_xyz_m = Eigen::Vector3d::Zero();  // t_est - t_true, base_link
   Eigen::Vector3d trans_err_xyz_m_initial = Eigen::Vector3d::Zero();
+  // The true extrinsic as a mapper config states one (input.extrinsic: xyz, rpy_deg with
+  // R = Rz(yaw) Ry(pitch) Rx(roll)), so a tool can hand the truth to the mapper.
+  Eigen::Vector3d true_xyz_m = Eigen::Vector3d::Zero();
+  Eigen::Vector3d true_rpy_deg = Eigen::Vector3d::Zero();
   ErrorSummary ipm_grid_err_m;          // refined extrinsic
   ErrorSummary ipm_grid_err_m_initial;  // extrinsic handed to the mapper
   int ipm_grid_pixels = 0;              // grid pixels in the 5-30 m band under the truth
@@ -201,6 +206,7 @@ struct PoseFrameError {
   double stamp = 0.0;
   double trans_err_m = 0.0, rot_err_deg = 0.0, yaw_err_deg = 0.0;                    // corrected
   double trans_err_m_input = 0.0, rot_err_deg_input = 0.0, yaw_err_deg_input = 0.0;  // odometry
+  bool moving = false;  // the true speed there is at least pose_moving_min_speed_mps
 };
 
 // Corrected poses and input odometry against the true poses (no alignment: all share `map`).
@@ -213,6 +219,11 @@ struct PoseMetrics {
   // |error| along and across the true heading (x, y of the true base_link): slow odometry
   // drift shows along the road (markings fix it) and across it (lanes fix it) differently.
   ErrorSummary along_err_m, across_err_m, along_err_m_input, across_err_m_input;
+  // The translation errors over the frames where the vehicle moves (true speed at least
+  // EvaluationOptions::pose_moving_min_speed_mps): a standstill's many frames weigh as much
+  // as one place in the mean above.
+  int frames_moving = 0;
+  ErrorSummary trans_err_moving_m, trans_err_moving_m_input;
   std::vector<PoseFrameError> frames;
 };
 
