@@ -1,7 +1,7 @@
 #!/usr/bin/python3
-"""Tests of the long-drive benchmark's arithmetic (scripts/long_drive_split.py and the
-per-part CPU / RSS figures of scripts/benchmark_long.py) on a hand-made drive, map and
---stats-out CSV. Run: python3 test/eval/test_long_drive_split.py
+"""Tests of the long-drive benchmark's arithmetic (scripts/irm_bench/long_split.py and the
+per-part CPU / RSS figures of scripts/irm_bench/long_stats.py) on a hand-made drive, map and
+--stats-out CSV. Run: python3 test/eval/test_long_split.py
 """
 import math
 import os
@@ -10,8 +10,9 @@ import tempfile
 import unittest
 
 sys.path.insert(0, os.path.join(os.path.dirname(os.path.abspath(__file__)), "..", "..", "scripts"))
-import benchmark_long  # noqa: E402
-import long_drive_split  # noqa: E402
+from irm_bench import long_split  # noqa: E402
+from irm_bench import long_stats  # noqa: E402
+from irm_bench.runners import BenchmarkError  # noqa: E402
 
 
 def pose(x, y):
@@ -48,7 +49,7 @@ def vector_map():
 
 class DriveIndexTest(unittest.TestCase):
     def test_distances_and_nearest_frames(self):
-        index = long_drive_split.DriveIndex(straight_drive())
+        index = long_split.DriveIndex(straight_drive())
         self.assertAlmostEqual(index.total_m, 600.0)
         self.assertAlmostEqual(index.distance_at_point([123.4, 8.0]), 124.0)  # indexed every 2 m
         self.assertAlmostEqual(index.distance_at_point([-50.0, 0.0]), 0.0)
@@ -58,15 +59,15 @@ class DriveIndexTest(unittest.TestCase):
         self.assertAlmostEqual(index.distance_at_stamp(0.0), 0.0)
 
     def test_equal_parts_cover_the_drive(self):
-        parts = long_drive_split.equal_parts(600.0, 6)
+        parts = long_split.equal_parts(600.0, 6)
         self.assertEqual(parts[0], (0.0, 100.0))
         self.assertEqual(parts[-1], (500.0, 600.0))
 
 
 class DriveSplitTest(unittest.TestCase):
     def setUp(self):
-        self.split = long_drive_split.DriveSplit(ground_truth(), vector_map(), margin_m=30.0)
-        self.parts = long_drive_split.equal_parts(self.split.index.total_m, 6)
+        self.split = long_split.DriveSplit(ground_truth(), vector_map(), margin_m=30.0)
+        self.parts = long_split.equal_parts(self.split.index.total_m, 6)
 
     def test_every_spline_segment_lands_in_exactly_one_part(self):
         original = vector_map()["lanes"][0]["control_points"]
@@ -90,7 +91,7 @@ class DriveSplitTest(unittest.TestCase):
         whole = vector_map()
         whole["lanes"][0]["predecessors"] = [1]
         whole["lanes"][0]["successors"] = [9]
-        split = long_drive_split.DriveSplit(ground_truth(), whole, margin_m=30.0)
+        split = long_split.DriveSplit(ground_truth(), whole, margin_m=30.0)
         for d0, d1 in self.parts:
             for lane in split.map_part(d0, d1)["lanes"]:
                 self.assertEqual(lane["predecessors"], [])
@@ -103,7 +104,7 @@ class DriveSplitTest(unittest.TestCase):
         whole = vector_map()
         whole["lanes"][0]["unmeasured"] = [[30, 36], [66, 66]]
         laid_x = {3.0 * k - 3.0 for k in list(range(30, 37)) + [66]}
-        split = long_drive_split.DriveSplit(ground_truth(), whole, margin_m=30.0)
+        split = long_split.DriveSplit(ground_truth(), whole, margin_m=30.0)
         flagged = set()
         for d0, d1 in self.parts:
             for lane in split.map_part(d0, d1)["lanes"]:
@@ -148,31 +149,31 @@ class StatsTest(unittest.TestCase):
             if k > 0:
                 cpu += 0.010 if k < 50 else 0.020
             lines.append("%d,%.2f,%.3f,%d" % (k, 1000.0 + 0.05 * k, cpu, 100000 + 1024 * k))
-        stats = benchmark_long.read_stats(self.write("\n".join(lines) + "\n"))
+        stats = long_stats.read_stats(self.write("\n".join(lines) + "\n"))
         distances = [10.0 * k for k in range(101)]  # 1 km drive
-        tenths = benchmark_long.cpu_ms_per_frame_by_part(stats, distances, 1000.0, 10)
+        tenths = long_stats.cpu_ms_per_frame_by_part(stats, distances, 1000.0, 10)
         for ms in tenths[:5]:
             self.assertAlmostEqual(ms, 10.0, places=6)
         for ms in tenths[5:]:
             self.assertAlmostEqual(ms, 20.0, places=6)
         # Rows sparser than frames (every 5th frame) give the same cost per frame.
-        sparse = benchmark_long.cpu_ms_per_frame_by_part(stats[::5], distances[::5], 1000.0, 10)
+        sparse = long_stats.cpu_ms_per_frame_by_part(stats[::5], distances[::5], 1000.0, 10)
         for ms in sparse[:4]:
             self.assertAlmostEqual(ms, 10.0, places=6)
         for ms in sparse[6:]:
             self.assertAlmostEqual(ms, 20.0, places=6)
-        growth = benchmark_long.slope([d / 1e3 for d in distances],
-                                      [row[3] / 1024.0 for row in stats])
+        growth = long_stats.slope([d / 1e3 for d in distances],
+                                  [row[3] / 1024.0 for row in stats])
         self.assertAlmostEqual(growth, 100.0)  # 1 MB per 10 m
 
     def test_a_wrong_header_is_a_clear_error(self):
-        with self.assertRaises(SystemExit) as raised:
-            benchmark_long.read_stats(self.write("frame,cpu_s\n1,2\n"))
+        with self.assertRaises(BenchmarkError) as raised:
+            long_stats.read_stats(self.write("frame,cpu_s\n1,2\n"))
         self.assertIn("expected the header frame,stamp,cpu_s,rss_kb", str(raised.exception))
 
     def test_startup_is_read_from_the_summary(self):
-        self.assertAlmostEqual(benchmark_long.startup_s(self.write("x\n  startup_s: 1.25\n")), 1.25)
-        self.assertIsNone(benchmark_long.startup_s(self.write("nothing here\n")))
+        self.assertAlmostEqual(long_stats.startup_s(self.write("x\n  startup_s: 1.25\n")), 1.25)
+        self.assertIsNone(long_stats.startup_s(self.write("nothing here\n")))
 
 
 if __name__ == "__main__":

@@ -64,7 +64,7 @@ TEST(InstructionSpans, SkipsSpansNoFrameFellInAndDumpsAnOpenSpanAtTheEnd) {
 }
 
 TEST(InstructionSpans, DumpNameIsWhatTheBenchmarkParses) {
-  // scripts/benchmark_long.py reads "span (\d+) frames (\d+)".
+  // scripts/irm_bench/long_stats.py reads "span (\d+) frames (\d+)".
   EXPECT_EQ(InstructionSpans::DumpName(2, 610, 12.5, 73.4),
             "span 2 frames 610 stamps 12.500-73.400");
 }

@@ -56,7 +56,7 @@ class InstructionSpans {
   void Finish();
 
   // "span <k> frames <n> stamps <first>-<last>": the dump name of span k (exposed for tests
-  // and for scripts/benchmark_long.py, which parses it).
+  // and for scripts/irm_bench/long_stats.py, which parses it).
   static std::string DumpName(std::size_t span, std::size_t frames, double first_stamp,
                               double last_stamp);
 

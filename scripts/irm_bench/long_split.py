@@ -1,4 +1,4 @@
-"""Splits a drive's map and ground truth by distance along the drive (benchmark_long.py).
+"""Splits a drive's map and ground truth by distance along the drive (the long-drive table).
 
 Every element gets the distance driven at the true frame position nearest to it
 (horizontally): a marking by its center, a lane piece by its midpoint, a pose by its stamp.
