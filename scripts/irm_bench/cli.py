@@ -102,8 +102,7 @@ def write_docs(ctx, args, printed):
     stamp = "Printed by `bash scripts/benchmark.sh%s --write-docs` at commit %s." % (
         flag, commit(ctx.repo))
     for module, tables in printed:
-        body = "\n\n".join([stamp] + [report.markdown(t) for t in tables
-                                      if not isinstance(t, report.Line) or t.docs])
+        body = "\n\n".join([stamp] + [report.markdown(t) for t in tables if t.docs])
         document = report.replace_section(document, module.__name__.rsplit(".", 1)[-1], body)
     with open(path, "w") as f:
         f.write(document)

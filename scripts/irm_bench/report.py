@@ -19,10 +19,12 @@ def arrow(before, after, digits=3):
 
 @dataclasses.dataclass
 class Table:
-    """One printed table: a title, the column names and rows of cells (any str()-able)."""
+    """One printed table: a title, the column names and rows of cells (any str()-able);
+    `docs`: it also goes into docs/benchmark.md."""
     title: str
     header: List[str]
     rows: List[list]
+    docs: bool = True
 
 
 @dataclasses.dataclass
