@@ -3,6 +3,7 @@
 its plan, the table layout, the docs sections and the target rows, on hand-made metrics (no
 tool runs). Run: python3 test/eval/test_benchmark_harness.py
 """
+import json
 import math
 import os
 import sys
@@ -13,9 +14,11 @@ import yaml
 
 REPO = os.path.normpath(os.path.join(os.path.dirname(os.path.abspath(__file__)), "..", ".."))
 sys.path.insert(0, os.path.join(REPO, "scripts"))
-from irm_bench import cli, configs, drives, plan, registry, report, targets  # noqa: E402
+from irm_bench import (cli, configs, drives, long_stats, plan, registry, report,  # noqa: E402
+                       targets)
+from irm_bench.runners import BenchmarkError  # noqa: E402
 from irm_bench.context import Context  # noqa: E402
-from irm_bench.tables import fleet_passes, full_method, speed  # noqa: E402
+from irm_bench.tables import fleet_passes, full_method, long_drive, speed  # noqa: E402
 
 
 class Folder(unittest.TestCase):
@@ -219,6 +222,65 @@ class FleetPasses(unittest.TestCase):
         self.assertEqual(worst[8:], ["0.200 -> 0.300 (pass_01)", "- -> -"])
         self.assertEqual(mean[1:6], ["1 / 6", "0.500", "0.55 / 0.90", "0.300", "0.75 -> 0.60"])
         self.assertEqual(len(table.header), len(worst))
+
+
+class FleetTargets(Folder):
+    def test_the_fleet_rows_read_every_pass(self):
+        fleet = os.path.join(self.tmp.name, "data", drives.FLEET)
+        for name, legs in (("pass_00", [(0, 40)]), ("pass_01", [(0, 30), (90, 30)])):
+            os.makedirs(os.path.join(fleet, name))
+            with open(os.path.join(fleet, name, "ground_truth_odom.json"), "w") as f:
+                json.dump({"frames": path(*legs)}, f)
+        open(os.path.join(fleet, "classes.yaml"), "w").close()
+        self.ctx.fleet = True
+        common = {"ceiling_markings": [{"gt_id": 1, "reachable": True},
+                                       {"gt_id": 2, "reachable": True}],
+                  "ceiling_markings_reachable": 2, "lane_f1": 0.5, "ceiling_lane_f1": 1.0,
+                  "ipm_grid_err_m": 0.2, "ipm_grid_err_m_initial": 0.3,
+                  "extrinsic_trans_err_m": 0.1, "extrinsic_trans_err_m_initial": 0.1,
+                  "pose_trans_err_moving_m_input": 0.2}
+        results = {
+            ("av2_pit_fleet_pass_00", "ours_ppsr"): dict(
+                common, marking_matched=1, marking_ape_mean_m=0.4, lane_ape_mean_m=0.3,
+                gt_markings=[{"gt_id": 1, "matched": True}], extrinsic_rot_err_deg=0.9,
+                extrinsic_rot_err_deg_initial=0.8, pose_trans_err_moving_m=0.1),
+            ("av2_pit_fleet_pass_01", "ours_ppsr"): dict(
+                common, marking_matched=0, marking_ape_mean_m=None, lane_ape_mean_m=0.1,
+                gt_markings=[], extrinsic_rot_err_deg=0.2, extrinsic_rot_err_deg_initial=0.8,
+                pose_trans_err_moving_m=0.3)}
+        table = targets.group_table(self.ctx, results, targets.load(), fleet_passes.GROUP,
+                                    fleet_passes.FUNCTIONS, "")
+        now = [row[2] for row in table.rows]
+        self.assertEqual(now[0], "1 / 4 (0.25); centre APE mean 0.400 m, worst 0.400 m (pass_00)")
+        self.assertEqual(now[1], "1 / 2")
+        self.assertEqual(now[2], "F1 0.50 of the ceiling (pass_00); lane APE 0.300 m (pass_00)")
+        self.assertEqual(now[3], "IPM grid: none; rotation: pass_00; translation: none")
+        self.assertEqual(now[4], "0.20 (pass_01); turning: pass_01")
+        self.assertEqual(now[5], "1.50 (pass_01)")
+
+
+class LongDrive(Folder):
+    def test_the_unload_line_is_read(self):
+        line = ("long drive: 20118 frames pushed in 300.1 s (20118 poses, 660 markings, 30 lanes, "
+                "10.06 km driven); unload: Finish 2.68 s (finished map), saved at 3.00 s, mapping "
+                "thread joined at 3.02 s; budget 3.0 s\n")
+        self.assertEqual(long_stats.unload_figures(line), (3.02, 3.0))
+        self.assertEqual(long_stats.unload_figures("[  SKIPPED ] set IRM_LONG_BAG"), (None, None))
+
+    def test_publish_stats_are_read_by_column_name(self):
+        path = os.path.join(self.tmp.name, "publish.csv")
+        with open(path, "w") as f:
+            f.write("km,frame,markings,lanes,changed_elements,export_changes_ms,"
+                    "export_snapshot_ms,publish_ms,publish_old_ms\n1,20,5,2,3,0.02,0.04,0.3,0.9\n")
+        rows = long_stats.read_publish_stats(path)
+        self.assertEqual((rows[0]["km"], rows[0]["publish_ms"]), (1.0, 0.3))
+        table = long_drive.publish_rows(rows)
+        self.assertEqual(table[0], ["publish CPU per publish at 1 km (delta + markers)", "0.300 ms"])
+        with open(path, "w") as f:
+            f.write("km,frame\n1,2\n")
+        with self.assertRaises(BenchmarkError):
+            long_stats.read_publish_stats(path)
+        self.assertIsNone(long_stats.read_publish_stats(path + ".absent"))
 
 
 class Targets(Folder):

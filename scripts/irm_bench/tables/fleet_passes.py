@@ -34,9 +34,7 @@ def requests(ctx):
 
 
 def pass_row(label, m):
-    return ([label, "%s / %s" % (m.get("marking_matched"), m.get("ceiling_markings_reachable")),
-             fmt(m.get("marking_ape_mean_m")),
-             "%s / %s" % (fmt(m.get("lane_f1"), 2), fmt(m.get("ceiling_lane_f1"), 2)),
+    return ([label, crossings_cell(m), fmt(m.get("marking_ape_mean_m")), f1_cell(m),
              fmt(m.get("lane_ape_mean_m"))] +
             [before_after(m, key, digits, suffix) for _, key, digits, suffix in CHANGES])
 
@@ -59,30 +57,50 @@ def _tagged(text, label):
     return "%s (%s)" % (text, label) if label else text
 
 
+def crossing_shortfall(m):
+    """Minus the share of the view ceiling's crossings matched (None without a ceiling)."""
+    reachable = m.get("ceiling_markings_reachable")
+    return -(m.get("marking_matched") or 0) / reachable if reachable else None
+
+
+def f1_shortfall(m):
+    """Minus the lane F1 over its ceiling (None when either is missing)."""
+    share = ratio(m.get("lane_f1"), m.get("ceiling_lane_f1"))
+    return None if share is None else -share
+
+
+def growth(key, suffix):
+    """How much an error grew: after / before for the poses (suffix _input), after - before
+    for the extrinsic (None when either is missing)."""
+    def score(m):
+        after, before = m.get(key), m.get(key + suffix)
+        if suffix == "_input":
+            return ratio(after, before)
+        return None if after is None or before is None else after - before
+    return score
+
+
+def crossings_cell(m):
+    return "%s / %s" % (m.get("marking_matched"), m.get("ceiling_markings_reachable"))
+
+
+def f1_cell(m):
+    return "%s / %s" % (fmt(m.get("lane_f1"), 2), fmt(m.get("ceiling_lane_f1"), 2))
+
+
 def worst_row(rows):
     """Each column's worst pass: fewest crossings and lowest F1 against the ceiling, largest
-    APE, largest growth of an error (after - before, or after / before for the poses)."""
+    APE, largest growth of an error."""
+    columns = [(crossing_shortfall, crossings_cell),
+               (lambda m: m.get("marking_ape_mean_m"), lambda m: fmt(m.get("marking_ape_mean_m"))),
+               (f1_shortfall, f1_cell),
+               (lambda m: m.get("lane_ape_mean_m"), lambda m: fmt(m.get("lane_ape_mean_m")))]
+    columns += [(growth(key, suffix), lambda m, k=key, d=digits, s=suffix: before_after(m, k, d, s))
+                for _, key, digits, suffix in CHANGES]
     cells = ["worst"]
-    label, m = _worst(rows, lambda m: None if not m.get("ceiling_markings_reachable") else
-                      -(m.get("marking_matched") or 0) / m["ceiling_markings_reachable"])
-    cells.append(_tagged("%s / %s" % (m.get("marking_matched"),
-                                      m.get("ceiling_markings_reachable")), label))
-    label, m = _worst(rows, lambda m: m.get("marking_ape_mean_m"))
-    cells.append(_tagged(fmt(m.get("marking_ape_mean_m")), label))
-    label, m = _worst(rows, lambda m: None if ratio(m.get("lane_f1"), m.get("ceiling_lane_f1"))
-                      is None else -ratio(m.get("lane_f1"), m.get("ceiling_lane_f1")))
-    cells.append(_tagged("%s / %s" % (fmt(m.get("lane_f1"), 2), fmt(m.get("ceiling_lane_f1"), 2)),
-                         label))
-    label, m = _worst(rows, lambda m: m.get("lane_ape_mean_m"))
-    cells.append(_tagged(fmt(m.get("lane_ape_mean_m")), label))
-    for _, key, digits, suffix in CHANGES:
-        if suffix == "_input":
-            score = lambda m, k=key, s=suffix: ratio(m.get(k), m.get(k + s))
-        else:
-            score = lambda m, k=key, s=suffix: (None if m.get(k) is None or m.get(k + s) is None
-                                                else m[k] - m[k + s])
+    for score, cell in columns:
         label, m = _worst(rows, score)
-        cells.append(_tagged(before_after(m, key, digits, suffix), label))
+        cells.append(_tagged(cell(m), label))
     return cells
 
 
@@ -161,8 +179,7 @@ def fleet_crossings_covered(scope):
 
 def fleet_lanes(scope):
     rows = _full_rows(scope)
-    label, m = _worst(rows, lambda m: None if ratio(m.get("lane_f1"), m.get("ceiling_lane_f1"))
-                      is None else -ratio(m.get("lane_f1"), m.get("ceiling_lane_f1")))
+    label, m = _worst(rows, f1_shortfall)
     f1 = _tagged("%s of the ceiling" % fmt(ratio(m.get("lane_f1"), m.get("ceiling_lane_f1")), 2),
                  label)
     label, m = _worst(rows, lambda m: m.get("lane_ape_mean_m"))
@@ -191,10 +208,8 @@ def fleet_turning_rotation(scope):
 
 
 def fleet_pose_ratio(scope):
-    rows = _full_rows(scope)
-    score = lambda m: ratio(m.get("pose_trans_err_moving_m"),
-                            m.get("pose_trans_err_moving_m_input"))
-    label, m = _worst(rows, score)
+    score = growth("pose_trans_err_moving_m", "_input")
+    label, m = _worst(_full_rows(scope), score)
     return _tagged(fmt(score(m) if m else None, 2), label)
 
 
