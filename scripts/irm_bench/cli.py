@@ -71,7 +71,7 @@ def lock(out):
         fcntl.flock(handle, fcntl.LOCK_EX | fcntl.LOCK_NB)
     except OSError:
         raise BenchmarkError("another benchmark run is using %s (wait for it, or pass --out "
-                             "<another folder>)" % out)
+                             "<another folder>)" % out, exit_code=2)
     return handle
 
 
@@ -137,5 +137,5 @@ def main(argv=None):
         run(parse(argv))
     except BenchmarkError as e:
         print("benchmark: error: %s" % e, file=sys.stderr)
-        return 2 if "another benchmark run" in str(e) else 1
+        return e.exit_code
     return 0

@@ -11,7 +11,12 @@ import yaml
 
 
 class BenchmarkError(Exception):
-    """A run that failed; the message names the command and its log."""
+    """A run that failed; the message names the command and its log. `exit_code`: the
+    benchmark's exit status (2: another run holds the output folder)."""
+
+    def __init__(self, message, exit_code=1):
+        super().__init__(message)
+        self.exit_code = exit_code
 
 
 def run(command, log):

@@ -61,6 +61,7 @@ def fill(template, scope, functions):
 
 
 def load(path=PATH):
+    """The rows of the targets file, their keys checked (unknown or missing: ValueError)."""
     rows = load_yaml(path)
     if not isinstance(rows, list):
         raise ValueError("%s: expected a list of rows" % path)

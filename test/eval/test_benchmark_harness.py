@@ -90,6 +90,16 @@ class Selection(Folder):
         self.assertIsNone(passes[0].scenario)  # read in place, never generated
 
 
+class Lock(Folder):
+    def test_a_second_run_on_one_folder_stops(self):
+        first = cli.lock(self.tmp.name)
+        self.addCleanup(first.close)
+        with self.assertRaises(BenchmarkError) as raised:
+            cli.lock(self.tmp.name)
+        self.assertEqual(raised.exception.exit_code, 2)
+        self.assertIn("another benchmark run is using", str(raised.exception))
+
+
 class WrittenConfigs(Folder):
     def test_true_extrinsic_comes_from_the_evaluators_figures(self):
         needed = {"extrinsic_true_xyz_m": [1.5, 0.0, 1.4],
