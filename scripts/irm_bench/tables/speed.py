@@ -1,17 +1,13 @@
 """Speed: every ablation's frames per second, front-end time and window solves; then plain IPM
 and the full method side by side, CPU per frame from the same run, and their ratio."""
-from ..configs import ABLATIONS, FULL, IPM, ablation
+from . import ablations
+from ..configs import ABLATIONS, FULL, IPM
 from ..metrics import cpu_ms_per_frame, ratio
-from ..plan import Request
 from ..report import Table, fmt
 
 TITLE = "Speed"
 MODES = ("all",)
-
-
-def requests(ctx):
-    return [Request(ctx.drive(s), ablation(config)) for s in ctx.scenarios
-            for _, config in ABLATIONS]
+requests = ablations.requests  # the same maps: every ablation on every drive
 
 
 def _solve_ms(md, key):
