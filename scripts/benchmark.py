@@ -231,6 +231,8 @@ def main():
     parser.add_argument("--out", default=None)
     parser.add_argument("--long", action="store_true",
                         help="the long-drive benchmark only (10 km, scripts/benchmark_long.py)")
+    parser.add_argument("--kitti", action="store_true",
+                        help="the real-image table alone (Table K, scripts/benchmark_kitti.py)")
     parser.add_argument("--instructions", action="store_true",
                         help="with --long: also count instructions per frame of three copies of "
                              "the route under callgrind (hours: valgrind is 20-30x slower)")
@@ -252,6 +254,9 @@ def main():
     if args.long:
         import benchmark_long
         return benchmark_long.main(args, out_root)
+    if args.kitti:
+        import benchmark_kitti
+        return benchmark_kitti.main(args, out_root)
     wall_start = time.time()
     scenarios = ["public_road"] if args.quick else args.scenarios.split(",")
     drives = {}  # name -> folder with drive.bag and ground_truth.json
@@ -325,6 +330,8 @@ def main():
     print_ablation_tables(scenarios, results, extra)
     if extra:
         benchmark_issues.print_tables(scenarios, results, table, fmt, real_absent)
+        import benchmark_kitti  # Table K: real camera images (skipped when absent)
+        benchmark_kitti.main(args, out_root)
     json.dump({"%s/%s" % k: {kk: vv for kk, vv in v.items() if not kk.startswith("_")}
                for k, v in results.items()}, open(os.path.join(out_root, "results.json"), "w"),
               indent=1)
