@@ -50,7 +50,9 @@ bool LaidAsCrossing(const std::vector<PaintPiece>& pieces, const std::vector<int
   const Eigen::Vector2d axis = eigen.eigenvectors().col(1);
   const Eigen::Vector2d stripe = pieces[stack.front()].direction;
   const double square = std::abs(axis.dot(stripe));  // cos of the angle: 0 when square
-  const double spread = std::sqrt(std::max(0.0, eigen.eigenvalues()(1)) * 12.0);
+  // The centers' extent along the axis (uniformly spaced: sqrt(12 variance)).
+  const double spread =
+      std::sqrt(std::max(0.0, eigen.eigenvalues()(1)) * 12.0 / static_cast<double>(stack.size()));
   const double spacing = spread / static_cast<double>(stack.size() - 1);
   return square < std::sin(options.crossing_max_turn_deg * kDegToRad) &&
          spacing <= options.crossing_max_spacing_m;
@@ -164,34 +166,43 @@ void ClassifyBlob(const std::vector<PaintPiece>& pieces, int i, const ClassifyOp
   Emit({PaintClass::kArrow, {i}, 0.5 * p.paint_probability}, options, counters, out);
 }
 
-// Pieces inside a hatched area (its stripes' bounding box on the stripes' axes, grown by
-// area_margin_m) are part of it: a stripe broken or merged at its ends, the blob where two
-// chevron arms meet. No stray piece of hatching becomes a line.
-void AbsorbIntoAreas(const std::vector<PaintPiece>& pieces, const ClassifyOptions& options,
+// Pieces inside a stack's stripes (their bounding box on the stripes' axes, grown by
+// area_margin_m) join the stack's instances emitted from `first` on (a hatched area, or the
+// nearest crossing stripe): a stripe broken or merged at its ends, the blob where two chevron
+// arms meet. No stray piece of hatching or of a crossing becomes a line.
+void AbsorbIntoStack(const std::vector<PaintPiece>& pieces, const std::vector<int>& stack,
+                     const ClassifyOptions& options, std::size_t first,
                      std::vector<PaintInstance>* instances, std::vector<bool>* used) {
-  for (PaintInstance& area : *instances) {
-    if (area.paint_class != PaintClass::kHatchedArea) continue;
-    const Eigen::Vector2d u = pieces[area.pieces.front()].direction;
-    const Eigen::Vector2d v(-u.y(), u.x());
-    double lo_u = 1e18, hi_u = -1e18, lo_v = 1e18, hi_v = -1e18;
-    for (const int i : area.pieces) {
-      for (const Eigen::Vector2d& end : {pieces[i].Start(), pieces[i].End()}) {
-        lo_u = std::min(lo_u, end.dot(u));
-        hi_u = std::max(hi_u, end.dot(u));
-        lo_v = std::min(lo_v, end.dot(v));
-        hi_v = std::max(hi_v, end.dot(v));
+  if (first >= instances->size()) return;  // nothing emitted (low confidence)
+  const Eigen::Vector2d u = pieces[stack.front()].direction;
+  const Eigen::Vector2d v(-u.y(), u.x());
+  double lo_u = 1e18, hi_u = -1e18, lo_v = 1e18, hi_v = -1e18;
+  for (const int i : stack) {
+    for (const Eigen::Vector2d& end : {pieces[i].Start(), pieces[i].End()}) {
+      lo_u = std::min(lo_u, end.dot(u));
+      hi_u = std::max(hi_u, end.dot(u));
+      lo_v = std::min(lo_v, end.dot(v));
+      hi_v = std::max(hi_v, end.dot(v));
+    }
+  }
+  const double m = options.area_margin_m;
+  for (std::size_t i = 0; i < pieces.size(); ++i) {
+    const double a = pieces[i].center.dot(u), b = pieces[i].center.dot(v);
+    if ((*used)[i] || a < lo_u - m || a > hi_u + m || b < lo_v - m || b > hi_v + m) continue;
+    if (pieces[i].length_m > options.max_dash_length_m) continue;  // a line passing by
+    std::size_t nearest = first;
+    double best = 1e18;
+    for (std::size_t k = first; k < instances->size(); ++k) {
+      for (const int j : (*instances)[k].pieces) {
+        const double d = (pieces[j].center - pieces[i].center).squaredNorm();
+        if (d < best) {
+          best = d;
+          nearest = k;
+        }
       }
     }
-    const double m = options.area_margin_m;
-    for (std::size_t i = 0; i < pieces.size(); ++i) {
-      if ((*used)[i]) continue;
-      const double a = pieces[i].center.dot(u), b = pieces[i].center.dot(v);
-      if (a < lo_u - m || a > hi_u + m || b < lo_v - m || b > hi_v + m) continue;
-      // A long line passing the area is no part of it.
-      if (pieces[i].length_m > options.max_dash_length_m) continue;
-      area.pieces.push_back(static_cast<int>(i));
-      (*used)[i] = true;
-    }
+    (*instances)[nearest].pieces.push_back(static_cast<int>(i));
+    (*used)[i] = true;
   }
 }
 
@@ -231,11 +242,15 @@ std::vector<PaintInstance> ClassifyPaint(const std::vector<PaintPiece>& pieces,
                                          ClassifyCounters* counters) {
   std::vector<PaintInstance> instances;
   std::vector<bool> used(pieces.size(), false);
-  for (const std::vector<int>& stack : StackStrokes(pieces, group_options)) {
-    ClassifyStack(pieces, stack, options, counters, &instances);
+  const std::vector<std::vector<int>> stacks = StackStrokes(pieces, group_options);
+  for (const std::vector<int>& stack : stacks) {
     for (const int i : stack) used[i] = true;
   }
-  AbsorbIntoAreas(pieces, options, &instances, &used);
+  for (const std::vector<int>& stack : stacks) {
+    const std::size_t first = instances.size();
+    ClassifyStack(pieces, stack, options, counters, &instances);
+    AbsorbIntoStack(pieces, stack, options, first, &instances, &used);
+  }
   for (const std::vector<int>& chain : ChainStrokes(pieces, used, group_options)) {
     ClassifyChain(pieces, chain, options, footprint, counters, &instances);
     for (const int i : chain) used[i] = true;

@@ -12,18 +12,37 @@ namespace {
 
 constexpr double kDegToRad = M_PI / 180.0;
 
-// Union-find over cell indices, with path halving.
-class DisjointSets {
+// Union-find over cell indices (path halving) that keeps each set's summed doubled-angle
+// direction, so that a set is compared by its mean direction: paint that turns gradually
+// (a chevron bending into its edge line through the smoothing) cannot chain two directions
+// into one piece cell by cell.
+class DirectedSets {
  public:
-  explicit DisjointSets(int n) : parent_(n) { std::iota(parent_.begin(), parent_.end(), 0); }
+  explicit DirectedSets(int n) : parent_(n), sum_(n, Eigen::Vector2f::Zero()) {
+    std::iota(parent_.begin(), parent_.end(), 0);
+  }
+  void SetDirection(int i, const Eigen::Vector2f& doubled) { sum_[i] = doubled; }
   int Find(int i) {
     while (parent_[i] != i) i = parent_[i] = parent_[parent_[i]];
     return i;
   }
-  void Join(int a, int b) { parent_[Find(a)] = Find(b); }
+  // Joins the sets of a and b when their mean directions are within min_dot (cos of twice
+  // the angle); undirected sets (zero sums) join only undirected ones.
+  void JoinIfAligned(int a, int b, float min_dot) {
+    a = Find(a);
+    b = Find(b);
+    if (a == b) return;
+    const float na = sum_[a].norm(), nb = sum_[b].norm();
+    const bool directed_a = na > 0.0f, directed_b = nb > 0.0f;
+    if (directed_a != directed_b) return;
+    if (directed_a && sum_[a].dot(sum_[b]) < min_dot * na * nb) return;
+    parent_[a] = b;
+    sum_[b] += sum_[a];
+  }
 
  private:
   std::vector<int> parent_;
+  std::vector<Eigen::Vector2f> sum_;
 };
 
 // Per cell, the doubled stroke angle (cos 2a, sin 2a) of the paint's direction in raster
@@ -131,24 +150,23 @@ PieceSplit SplitPaint(const GroundRaster& raster, const cv::Mat& paint, const cv
   // Two directions within max_turn: their doubled angles' dot product above cos(2 max_turn).
   const float min_dot = static_cast<float>(std::cos(2.0 * options.max_turn_deg * kDegToRad));
   const float min_coherence = static_cast<float>(options.min_coherence);
-  DisjointSets sets(rows * cols);
+  DirectedSets sets(rows * cols);
+  for (int r = 0; r < rows; ++r) {
+    const uchar* row = paint.ptr<uchar>(r);
+    for (int c = 0; c < cols; ++c) {
+      if (!row[c] || coherence.at<float>(r, c) < min_coherence) continue;
+      sets.SetDirection(r * cols + c, {cos2.at<float>(r, c), sin2.at<float>(r, c)});
+    }
+  }
   for (int r = 0; r < rows; ++r) {
     const uchar* row = paint.ptr<uchar>(r);
     for (int c = 0; c < cols; ++c) {
       if (!row[c]) continue;
-      const bool directed = coherence.at<float>(r, c) >= min_coherence;
       // The neighbours already visited: left, and the three above.
       for (const auto& [dr, dc] : {std::pair{0, -1}, {-1, -1}, {-1, 0}, {-1, 1}}) {
         const int rr = r + dr, cc = c + dc;
         if (rr < 0 || cc < 0 || cc >= cols || !paint.at<uchar>(rr, cc)) continue;
-        const bool other_directed = coherence.at<float>(rr, cc) >= min_coherence;
-        bool join = !directed && !other_directed;
-        if (directed && other_directed) {
-          join = cos2.at<float>(r, c) * cos2.at<float>(rr, cc) +
-                     sin2.at<float>(r, c) * sin2.at<float>(rr, cc) >=
-                 min_dot;
-        }
-        if (join) sets.Join(r * cols + c, rr * cols + cc);
+        sets.JoinIfAligned(r * cols + c, rr * cols + cc, min_dot);
       }
     }
   }
