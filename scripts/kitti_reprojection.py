@@ -70,14 +70,22 @@ def rotation_deg(R):
     return math.degrees(math.acos(max(-1.0, min(1.0, (np.trace(R) - 1) / 2))))
 
 
-def pose_errors(estimate, truth):
+def pose_errors(estimate, truth, align_first=False):
     """Mean translation (m) and rotation (deg) error of `estimate` (stamp -> pose) against
-    `truth` at the truth's stamps both hold."""
+    `truth` at the truth's stamps both hold; with align_first, `estimate` moved rigidly so
+    that its first pose is the truth's (the error relative to the start of the clip)."""
     trans, rot = [], []
+    align = np.eye(4)
+    if align_first:
+        t0 = min(truth)
+        T0 = estimate.get(t0) if t0 in estimate else interpolate_pose(estimate, t0)
+        if T0 is not None:
+            align = truth[t0] @ np.linalg.inv(T0)
     for t, T_true in truth.items():
         T = estimate.get(t) if t in estimate else interpolate_pose(estimate, t)
         if T is None:
             continue
+        T = align @ T
         trans.append(np.linalg.norm(T[:3, 3] - T_true[:3, 3]))
         rot.append(rotation_deg(T[:3, :3].T @ T_true[:3, :3]))
     return (float(np.mean(trans)), float(np.mean(rot))) if trans else (float("nan"),) * 2

@@ -195,6 +195,14 @@ def odometry_samples(T_base, stamps, args):
     return samples
 
 
+def odometry_at(samples, t):
+    """The odometry pose interpolated at stamp t (samples: (t, T_odom_base, T_true))."""
+    times = [sample[0] for sample in samples]
+    j = int(np.clip(np.searchsorted(times, t) - 1, 0, len(samples) - 2))
+    f = (t - times[j]) / (times[j + 1] - times[j])
+    return interpolate(samples[j][1], samples[j + 1][1], f)
+
+
 def odometry_msg(samples, j, frame, child):
     a, b = max(0, j - 1), min(len(samples) - 1, j + 1)
     t, T, _ = samples[j]
@@ -260,14 +268,11 @@ def main():
 
     os.makedirs(args.out, exist_ok=True)
     samples = odometry_samples(T_base, stamps, args)
-    odom_at = lambda t: interpolate(*min(((samples[j][1], samples[j + 1][1], (t - samples[j][0]) / (samples[j + 1][0] - samples[j][0]))
-                                         for j in range(len(samples) - 1)
-                                         if samples[j][0] <= t <= samples[j + 1][0]), key=lambda s: 0))
     with open(os.path.join(args.out, "ground_truth_tum.txt"), "w") as truth, \
          open(os.path.join(args.out, "odometry_tum.txt"), "w") as odom:
         for t, T in zip(stamps, T_base):
             truth.write(tum_line(t, T))
-            odom.write(tum_line(t, odom_at(t)))
+            odom.write(tum_line(t, odometry_at(samples, t)))
     with open(os.path.join(args.out, "mount_from_trajectory.txt"), "w") as f:
         f.write("# T_base_cam (4x4) derived from the GPS/INS trajectory (kitti_to_bag.py)\n")
         np.savetxt(f, T_base_cam)

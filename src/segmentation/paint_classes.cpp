@@ -34,9 +34,10 @@ void Emit(PaintInstance instance, const ClassifyOptions& options, ClassifyCounte
   out->push_back(std::move(instance));
 }
 
-// True when the stripes of a stack are laid as a crossing's: side by side square to their
-// direction (the line through their centers within crossing_max_turn_deg of square), a
-// stripe's width or two apart. Hatching is laid along a slanted border, and wider apart.
+// True when the stripes of a stack are laid as a crossing's: along the travel, side by side
+// square to their direction (the line through their centers within crossing_max_turn_deg of
+// square), a stripe's width or two apart. Hatching is laid along a slanted border, and wider
+// apart.
 bool LaidAsCrossing(const std::vector<PaintPiece>& pieces, const std::vector<int>& stack,
                     const ClassifyOptions& options) {
   Eigen::Vector2d mean = Eigen::Vector2d::Zero();
@@ -54,8 +55,11 @@ bool LaidAsCrossing(const std::vector<PaintPiece>& pieces, const std::vector<int
   const double spread =
       std::sqrt(std::max(0.0, eigen.eigenvalues()(1)) * 12.0 / static_cast<double>(stack.size()));
   const double spacing = spread / static_cast<double>(stack.size() - 1);
+  // A crossing on the road driven runs along the travel; hatching seen obliquely can look
+  // square and close in one view, never along the travel as well.
   return square < std::sin(options.crossing_max_turn_deg * kDegToRad) &&
-         spacing <= options.crossing_max_spacing_m;
+         spacing <= options.crossing_max_spacing_m &&
+         TurnFromTravel(stripe) < options.crossing_max_turn_deg * kDegToRad;
 }
 
 // A stack of parallel strokes: crossing stripes when laid as a crossing, else one hatched

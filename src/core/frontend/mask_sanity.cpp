@@ -11,7 +11,8 @@ namespace ipm_road_mapper {
 namespace {
 
 constexpr double kDegToRad = M_PI / 180.0;
-constexpr int kMaxGroundPoints = 60;  // per piece: enough for a line fit and the evidence
+constexpr int kMaxGroundPoints = 60;        // per piece: enough for a line fit
+constexpr std::size_t kEvidenceStride = 4;  // of those, the class evidence
 
 // One 8-connected piece of a lane instance: its pixels and its line on the ground.
 struct Piece {
@@ -192,7 +193,10 @@ cv::Mat MaskSanity::Clean(const cv::Mat& mask, const Ipm& ipm, const Eigen::Isom
     for (std::size_t k = 0; k < lines.size(); ++k) {
       std::vector<Eigen::Vector2f> points_map;
       for (const int i : lines[k]) {
-        for (const Eigen::Vector2d& p : kept[i].ground) {
+        // Every kEvidenceStride-th ground point is evidence (the cost stays a few
+        // thousand distance checks per line).
+        for (std::size_t j = 0; j < kept[i].ground.size(); j += kEvidenceStride) {
+          const Eigen::Vector2d& p = kept[i].ground[j];
           points_map.push_back(
               (T_map_base * Eigen::Vector3d(p.x(), p.y(), 0.0)).head<2>().cast<float>());
         }
