@@ -21,6 +21,7 @@ struct Piece {
   Eigen::Vector2d center = Eigen::Vector2d::Zero();
   Eigen::Vector2d direction = Eigen::Vector2d::UnitX();
   bool has_line = false;  // at least two ground points apart
+  double length_m = 0.0;  // extent along direction
 };
 
 // The 8-connected pieces of an instance's pixels.
@@ -55,24 +56,42 @@ void FitGroundLine(const Ipm& ipm, Piece* piece) {
   piece->center = mean;
   piece->direction = eigen.eigenvectors().col(1);
   piece->has_line = eigen.eigenvalues()(1) > 1e-6;
+  double lo = 0.0, hi = 0.0;
+  for (const Eigen::Vector2d& p : piece->ground) {
+    lo = std::min(lo, (p - mean).dot(piece->direction));
+    hi = std::max(hi, (p - mean).dot(piece->direction));
+  }
+  piece->length_m = hi - lo;
 }
 
-// True when the two pieces lie on one line (dashes or fragments of one painted line).
-bool Collinear(const Piece& a, const Piece& b, const MaskSanityOptions& options) {
-  if (!a.has_line || !b.has_line) return true;  // too little to tell: one line
+// True when the two pieces are two lines, not one: side by side (near parallel, overlapping
+// along their direction, and apart across it by more than collinear_max_offset_m plus 5 % of
+// the distance: two lines merged in one instance), or crossing each other at more than
+// split_min_turn_deg (a line and a stripe merged). Pieces that follow each other along a
+// line stay one line, however a far view bends them.
+bool TwoLines(const Piece& a, const Piece& b, const MaskSanityOptions& options) {
+  if (!a.has_line || !b.has_line) return false;  // too little to tell: one line
   const double cos_turn = std::abs(a.direction.dot(b.direction));
+  if (cos_turn < std::cos(options.split_min_turn_deg * kDegToRad)) return true;
   if (cos_turn < std::cos(options.collinear_max_turn_deg * kDegToRad)) return false;
   const Eigen::Vector2d d = b.center - a.center;
   const Eigen::Vector2d u =
       (a.direction + (a.direction.dot(b.direction) < 0 ? -b.direction : b.direction)).normalized();
-  const double offset = std::abs(u.x() * d.y() - u.y() * d.x());
-  return offset <= options.collinear_max_offset_m + 0.05 * d.norm();
+  const double across = std::abs(u.x() * d.y() - u.y() * d.x());
+  const double overlap = 0.5 * (a.length_m + b.length_m) - std::abs(d.dot(u));
+  return overlap > 0.0 && across > options.collinear_max_offset_m + 0.05 * d.norm();
 }
 
-// Pieces grouped into lines (union-find over the collinear pairs), largest group first.
+// Pieces grouped into lines, largest group first: union-find over the pairs of pieces of at
+// least min_line_pixels that are not TwoLines; a smaller piece (a far dash, a fragment) is too
+// little to be a line of its own and goes with the largest group.
 std::vector<std::vector<int>> GroupIntoLines(const std::vector<Piece>& pieces,
                                              const MaskSanityOptions& options) {
   const int n = static_cast<int>(pieces.size());
+  const auto big = [&](int i) {
+    return pieces[i].has_line &&
+           static_cast<int>(pieces[i].pixels.size()) >= options.min_line_pixels;
+  };
   std::vector<int> parent(n);
   std::iota(parent.begin(), parent.end(), 0);
   const auto root = [&parent](int i) {
@@ -81,11 +100,20 @@ std::vector<std::vector<int>> GroupIntoLines(const std::vector<Piece>& pieces,
   };
   for (int a = 0; a < n; ++a) {
     for (int b = a + 1; b < n; ++b) {
-      if (Collinear(pieces[a], pieces[b], options)) parent[root(a)] = root(b);
+      if (!big(a) || !big(b) || !TwoLines(pieces[a], pieces[b], options)) {
+        parent[root(a)] = root(b);
+      }
     }
   }
   std::map<int, std::vector<int>> by_root;
-  for (int i = 0; i < n; ++i) by_root[root(i)].push_back(i);
+  std::vector<int> small;
+  for (int i = 0; i < n; ++i) {
+    if (big(i)) {
+      by_root[root(i)].push_back(i);
+    } else {
+      small.push_back(i);
+    }
+  }
   std::vector<std::vector<int>> groups;
   for (auto& entry : by_root) groups.push_back(std::move(entry.second));
   const auto pixels = [&pieces](const std::vector<int>& g) {
@@ -95,6 +123,8 @@ std::vector<std::vector<int>> GroupIntoLines(const std::vector<Piece>& pieces,
   };
   std::sort(groups.begin(), groups.end(),
             [&](const auto& x, const auto& y) { return pixels(x) > pixels(y); });
+  if (groups.empty()) groups.emplace_back();
+  groups.front().insert(groups.front().end(), small.begin(), small.end());
   return groups;
 }
 
@@ -122,9 +152,12 @@ MaskSanityOptions LoadMaskSanityOptions(OptionsReader reader) {
                                   return "";
                                 });
   reader.Read<bool>("split_lanes", &o.split_lanes);
-  reader.Read<int>("min_piece_pixels", &o.min_piece_pixels, CheckPositiveInt);
+  reader.Read<int>("min_piece_pixels", &o.min_piece_pixels,
+                   [](const int& v) { return v >= 0 ? std::string() : "must be >= 0"; });
+  reader.Read<int>("min_line_pixels", &o.min_line_pixels, CheckPositiveInt);
   reader.Read<double>("collinear_max_turn_deg", &o.collinear_max_turn_deg, CheckPositive);
   reader.Read<double>("collinear_max_offset_m", &o.collinear_max_offset_m, CheckPositive);
+  reader.Read<double>("split_min_turn_deg", &o.split_min_turn_deg, CheckPositive);
   reader.Read<int>("flicker_memory_frames", &o.flicker_memory_frames,
                    [](const int& v) { return v >= 0 ? std::string() : "must be >= 0"; });
   reader.Read<double>("flicker_radius_m", &o.flicker_radius_m, CheckPositive);

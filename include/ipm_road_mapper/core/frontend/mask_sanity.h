@@ -1,9 +1,9 @@
 // The mask's instances made sane before extraction, for masks from a real network: area
 // classes (hatched areas) left out of the map and counted; a lane instance that holds
-// several lines (two lines merged into one instance, a line and a stray blob) split into
-// one instance per line, the pieces too small to be a line dropped; and a lane instance
-// whose class disagrees with what the last frames saw at the same place (solid <-> dashed
-// flicker) given the class the evidence there holds. Each is counted (MaskSanityCounters:
+// several lines (two lines side by side merged into one instance, a line and a stripe
+// crossing it) split into one instance per line, the pieces too small to be a line dropped; and a
+// lane instance whose class disagrees with what the last frames saw at the same place (solid <->
+// dashed flicker) given the class the evidence there holds. Each is counted (MaskSanityCounters:
 // the summary's `sanity:` line and the diagnostics).
 #pragma once
 
@@ -24,14 +24,20 @@ struct MaskSanityOptions {
   // Classes that are areas, not map elements (the segmenter's hatched_area): their pixels
   // are removed from the mask and each instance counted (hatched areas are not mapped).
   std::vector<int> area_class_ids{30};
-  bool split_lanes = true;               // a lane instance's pieces that are no one line split
-  int min_piece_pixels = 30;             // smaller pieces of a lane instance are dropped
-  double collinear_max_turn_deg = 15.0;  // two pieces of one line: directions this close...
-  double collinear_max_offset_m = 0.5;   // ... and one on the other's line within this
-  int flicker_memory_frames = 10;        // lane class evidence of this many frames (0: off)
-  double flicker_radius_m = 0.5;         // evidence this near an instance's points counts
-  double flicker_majority = 2.0;         // another class with this many times the votes wins
-  int flicker_min_votes = 20;            // ... and at least this many points of evidence
+  bool split_lanes = true;    // a lane instance's pieces that are no one line split
+  int min_piece_pixels = 0;   // smaller pieces of a lane instance are dropped (0: none)
+  int min_line_pixels = 200;  // a smaller piece is never split off as a line of its own
+  // Two pieces are two lines when side by side: directions within collinear_max_turn_deg,
+  // overlapping along them, apart across by more than collinear_max_offset_m (+5 % of their
+  // distance; two lines merged into one instance are a lane's width apart); or when their
+  // directions differ by more than split_min_turn_deg (a line and a stripe merged).
+  double collinear_max_turn_deg = 20.0;
+  double collinear_max_offset_m = 1.0;
+  double split_min_turn_deg = 45.0;
+  int flicker_memory_frames = 10;  // lane class evidence of this many frames (0: off)
+  double flicker_radius_m = 0.5;   // evidence this near an instance's points counts
+  double flicker_majority = 2.0;   // another class with this many times the votes wins
+  int flicker_min_votes = 20;      // ... and at least this many points of evidence
 };
 
 // Reads the section; throws OptionsError naming a bad or unknown key.
