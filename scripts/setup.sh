@@ -48,7 +48,11 @@ else
   log "Debian packages: all ${#wanted[@]} present"
 fi
 
-# --- 2. Build ----------------------------------------------------------------------------
+# --- 2. The segmentation runtime (OpenVINO from PyPI, into $build/venv) ---------------------
+mkdir -p "$build"
+bash "$repo/scripts/setup_openvino.sh" "$build"
+
+# --- 3. Build ----------------------------------------------------------------------------
 # catkin writes PYTHONPATH='' into its cached env unless this exists before configure.
 mkdir -p "$build/devel/lib/python3/dist-packages"
 # IRM_CMAKE_ARGS: extra CMake arguments, e.g. -DIRM_WARNINGS_AS_ERRORS=ON (scripts/test.sh

@@ -33,7 +33,11 @@ std::string MapperSummaryLines(const Mapper& mapper, const FrameAssembler& assem
     << " lanes doubling back (" << e.lane_rows_doubled
     << " lane rows of several runs), frames without observations: " << e.frames_too_many_instances
     << " too many instances, " << e.frames_too_much_coverage << " too much coverage ("
-    << e.dropped_absurd_frame << " instances); odometry reordered " << a.odometry_reordered << "\n";
+    << e.dropped_absurd_frame << " instances); odometry reordered " << a.odometry_reordered << "\n"
+    << "sanity: " << c.sanity.area_instances << " hatched-area instances left out, "
+    << c.sanity.lane_instances_split << " lane instances split into lines, "
+    << c.sanity.lane_pieces_dropped << " lane pieces dropped (too small), "
+    << c.sanity.lane_class_resolved << " lane classes resolved by evidence\n";
   for (const OversizedClass& suspect : MostlyOversizedClasses(e, mapper.classes())) {
     s << "warning: " << Describe(suspect) << "\n";
   }

@@ -74,6 +74,12 @@ void FillFrameStatus(const MapperStatusSnapshot& now, const MapperStatusSnapshot
   s->add("lane observations along a lane of another class (class flicker)",
          now.counters.lane_observations_other_class);
   s->add("marking views dropped: oversized", e.dropped_oversized);
+  // The mask's sanity stage (mask_sanity.h).
+  s->add("hatched-area instances left out", now.counters.sanity.area_instances);
+  s->add("lane instances split into lines", now.counters.sanity.lane_instances_split);
+  s->add("lane pieces dropped (too small)", now.counters.sanity.lane_pieces_dropped);
+  s->add("lane classes resolved by evidence (class flicker)",
+         now.counters.sanity.lane_class_resolved);
   for (const std::string& warning : now.class_table_warnings) s->add("class table", warning);
   s->addf("callback time mean (ms)", "%.3f", now.callback_mean_ms);
   s->addf("callback time max (ms)", "%.3f", now.callback_max_ms);

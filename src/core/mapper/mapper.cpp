@@ -68,6 +68,7 @@ Mapper::Mapper(MapperOptions options, ClassTable classes,
     : options_(WithEffectiveGates(std::move(options))),
       classes_(std::move(classes)),
       T_base_cam_initial_(T_base_cam_initial),
+      sanity_(options_.sanity, &classes_),
       store_(options_.backend.road_plane_radius_m),
       markings_(options_, &store_, &counters_),
       lanes_(options_, &store_, &counters_),
@@ -132,8 +133,9 @@ FrameStatus Mapper::ProcessFrame(const FrameInput& input, std::string* reason) {
   trajectory_ground.ground = IpmGround::kTrajectory;
   const RoadPlane ahead_base =
       FrontEndGround(trajectory_ground, store_.frames(), input.stamp, input.T_map_base_odom);
+  const cv::Mat mask = sanity_.Clean(input.mask, ipm, input.T_map_base_odom, &counters_.sanity);
   FrameObservations observations =
-      ExtractObservations(input.mask, classes_, ipm, options_.ipm.error_model, options_.extraction);
+      ExtractObservations(mask, classes_, ipm, options_.ipm.error_model, options_.extraction);
   counters_.extraction.Add(observations.counters);
   AppendBounded(&frontend_timing_.extraction_ms, elapsed_ms(start));
 
@@ -187,6 +189,7 @@ void Mapper::PruneHistories() {
 
 void Mapper::Reset() {
   windows_.Reset();
+  sanity_.Reset();
   store_.Clear();
   last_stamp_ = -1.0;
 }

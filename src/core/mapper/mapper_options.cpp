@@ -105,6 +105,7 @@ MapperOptions LoadMapperOptions(OptionsReader reader) {
   MapperOptions o;
   reader.Read<std::string>("method", &o.method);
   o.ipm = LoadIpmOptions(reader.Child("ipm"));
+  o.sanity = LoadMaskSanityOptions(reader.Child("sanity"));
   o.extraction = LoadExtractionOptions(reader.Child("extraction"));
   o.association = LoadAssociationOptions(reader.Child("association"));
   o.lanes = LoadLaneOptions(reader.Child("lanes"));

@@ -167,6 +167,7 @@ class Mapper {
   const MapperOptions options_;
   const ClassTable classes_;
   const Eigen::Isometry3d T_base_cam_initial_;
+  MaskSanity sanity_;  // before extraction: area classes out, merged lanes split, flicker
   MapperCounters counters_;
   FrontEndTiming frontend_timing_;
   MapStore store_;

@@ -7,6 +7,7 @@
 #include <string>
 #include <vector>
 
+#include "ipm_road_mapper/core/frontend/mask_sanity.h"
 #include "ipm_road_mapper/core/frontend/observations.h"
 #include "ipm_road_mapper/core/mapper/timing_series.h"
 
@@ -17,6 +18,7 @@ struct MapperCounters {
   std::uint64_t frames_received = 0;
   std::uint64_t frames_used = 0;
   std::map<std::string, std::uint64_t> frames_skipped;  // reason key -> count
+  MaskSanityCounters sanity;  // what the mask's sanity stage changed (mask_sanity.h)
   ExtractionCounters extraction;
   std::uint64_t markings_created = 0;
   std::uint64_t lanes_created = 0;

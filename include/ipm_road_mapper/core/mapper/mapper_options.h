@@ -9,6 +9,7 @@
 #include "ipm_road_mapper/core/backend/backend_options.h"
 #include "ipm_road_mapper/core/frontend/association.h"
 #include "ipm_road_mapper/core/frontend/instance_extraction.h"
+#include "ipm_road_mapper/core/frontend/mask_sanity.h"
 #include "ipm_road_mapper/core/geometry/ipm_uncertainty.h"
 #include "ipm_road_mapper/core/geometry/lane_end_fit.h"
 #include "ipm_road_mapper/core/geometry/spline_fitting.h"
@@ -63,6 +64,7 @@ struct OdometryOptions {
 struct MapperOptions {
   std::string method = "ipm";  // name of the configuration, e.g. ipm, ours_ppsr
   IpmOptions ipm;
+  MaskSanityOptions sanity;  // the mask made sane before extraction (mask_sanity.h)
   ExtractionOptions extraction;
   AssociationOptions association;
   LaneOptions lanes;
